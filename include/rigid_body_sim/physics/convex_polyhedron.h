@@ -1,0 +1,59 @@
+// Convex polyhedron with half-edge adjacency, as the narrow phase needs it.
+#ifndef RIGID_BODY_SIM_PHYSICS_CONVEX_POLYHEDRON_H_
+#define RIGID_BODY_SIM_PHYSICS_CONVEX_POLYHEDRON_H_
+
+#include <vector>
+
+#include "rigid_body_sim/physics/mass_properties.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+// Half-edges come in twin pairs: half-edge 2k and 2k+1 are twins and form
+// edge k, so twin(h) = h ^ 1. Each face is a convex polygon whose half-edges
+// run counter-clockwise seen from outside.
+struct ConvexPolyhedron {
+  struct HalfEdge {
+    int origin = -1;  // vertex the half-edge starts at
+    int next = -1;    // next half-edge around the same face
+    int face = -1;    // face to the left of the half-edge
+  };
+  struct Face {
+    int first_half_edge = -1;
+    Vec3 normal = Vec3::Zero();  // unit, outward
+    double offset = 0.0;         // m; plane: normal . x = offset
+  };
+
+  std::vector<Vec3> vertices;             // m, shape frame, no duplicates
+  std::vector<HalfEdge> half_edges;
+  std::vector<Face> faces;
+  std::vector<int> vertex_half_edge;      // one outgoing half-edge per vertex
+  std::vector<Vec3> edge_directions;      // unit directions of edges, unique up to sign
+  Vec3 centroid = Vec3::Zero();           // m, the volume centroid
+
+  int EdgeCount() const { return static_cast<int>(half_edges.size() / 2); }
+  static int Twin(int half_edge) { return half_edge ^ 1; }
+  // Vertex indices of a face, counter-clockwise from outside.
+  std::vector<int> FaceVertices(int face) const;
+  // Index of the vertex furthest along `direction` (support mapping).
+  int SupportVertex(const Vec3& direction) const;
+  TriangleMesh Triangulate() const;
+};
+
+// Builds the half-edge structure from vertices and convex polygonal faces
+// (each counter-clockwise from outside). Coplanar neighbouring faces are merged.
+// Fails with a message when the faces do not form a closed 2-manifold or a
+// face is degenerate.
+Result<ConvexPolyhedron> MakeConvexPolyhedron(const std::vector<Vec3>& vertices,
+                                              const std::vector<std::vector<int>>& faces);
+
+ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size);  // full edge lengths, m, centred
+// Prism with `segments` sides inscribed in the cylinder, axis z, centred.
+ConvexPolyhedron MakeCylinderPolyhedron(double radius, double length, int segments);
+
+MassProperties PolyhedronMassProperties(double density, const ConvexPolyhedron& polyhedron);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_CONVEX_POLYHEDRON_H_

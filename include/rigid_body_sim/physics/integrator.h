@@ -1,0 +1,27 @@
+// Stage 5 of a step: time integration of the bodies' state.
+#ifndef RIGID_BODY_SIM_PHYSICS_INTEGRATOR_H_
+#define RIGID_BODY_SIM_PHYSICS_INTEGRATOR_H_
+
+#include <vector>
+
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+// Kick: P += (F + M g) dt and L += tau dt for every moving body, then clears
+// the force and torque accumulators. Records the external acceleration so the
+// drift can integrate it exactly.
+void IntegrateForces(const Vec3& gravity, double dt, std::vector<Body>* bodies);
+
+// Drift: advances x and q over dt with the momenta the step ended with.
+void IntegratePositions(double dt, std::vector<Body>* bodies);
+
+// Orientation after dt of torque-free motion with world angular momentum L
+// held constant: RK4 on q' = 1/2 (0, omega(q)) q, omega(q) = R(q) I^-1 R(q)^T L.
+Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_principal_moments,
+                      const Vec3& angular_momentum_world, double dt);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_INTEGRATOR_H_

@@ -1,0 +1,41 @@
+// Collision shapes attached to bodies.
+#ifndef RIGID_BODY_SIM_PHYSICS_SHAPE_H_
+#define RIGID_BODY_SIM_PHYSICS_SHAPE_H_
+
+#include <memory>
+#include <variant>
+
+#include "rigid_body_sim/physics/convex_polyhedron.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+struct Sphere {
+  double radius = 0.0;  // m
+};
+
+// The half-space z <= 0 of the shape frame; only static bodies may carry it.
+struct HalfSpace {};
+
+// Polyhedra are immutable and shared, so many bodies can use one hull.
+using ShapeGeometry =
+    std::variant<Sphere, std::shared_ptr<const ConvexPolyhedron>, HalfSpace>;
+
+struct Material {
+  double friction = 0.5;     // Coulomb coefficient mu, dimensionless, >= 0
+  double restitution = 0.0;  // coefficient of restitution e, in [0, 1]
+};
+
+struct ShapeDef {
+  ShapeGeometry geometry = Sphere{};
+  Pose body_from_shape = Pose::Identity();
+  Material material;
+};
+
+// Checks a shape definition: finite pose, positive radius, non-empty polyhedron,
+// material in range.
+Status ValidateShapeDef(const ShapeDef& shape);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_SHAPE_H_

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the build, the tests and the demo need.
+# Idempotent: runs apt-get only when a package is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake git
+  catkin ros-core-dev libroscpp-dev libroslib-dev ros-message-generation ros-message-runtime
+  libtf2-ros-dev liburdfdom-dev liburdf-dev libresource-retriever-dev
+  libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev libvisualization-msgs-dev
+  libassimp-dev libqhull-dev libeigen3-dev
+  libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
+  libbullet-dev libbenchmark-dev python3-matplotlib
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "[deps] all ${#packages[@]} Debian packages are installed"
+  exit 0
+fi
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "[deps] missing packages: ${missing[*]}" >&2
+  echo "[deps] run as root, or install them with: sudo apt-get install ${missing[*]}" >&2
+  exit 1
+fi
+
+echo "[deps] installing ${#missing[@]} packages: ${missing[*]}"
+echo "[deps] apt-get update ..."
+apt-get update -q
+echo "[deps] apt-get install ..."
+DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}" \
+  | grep --line-buffered -E '^(Setting up|Unpacking|E:)' || true
+for package in "${missing[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    echo "[deps] failed to install $package" >&2
+    exit 1
+  fi
+done
+echo "[deps] done"
