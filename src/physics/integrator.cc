@@ -1,10 +1,14 @@
 // The scheme, stated once:
 //  * Momenta are kicked by the step's forces first (symplectic Euler), so the
 //    contact solver sees and corrects the velocities the step will end with.
-//  * Position: x(t+dt) = x + dt v(t+dt) - dt^2/2 a_ext, which equals
-//    x + dt v(t) + dt^2/2 a_ext for a free body. It is exact for any constant
-//    external acceleration such as gravity, unlike plain symplectic Euler whose
-//    free-fall error is g t dt / 2.
+//  * Position: the trapezoidal rule x(t+dt) = x + dt/2 (v(t) + v(t+dt)),
+//    with v(t) taken after the collision impulses and v(t+dt) after the
+//    contact solver. For a free body this is x + dt v + dt^2/2 a: exact for
+//    any constant external acceleration such as gravity, unlike plain
+//    symplectic Euler whose free-fall error is g t dt / 2. A body that a
+//    resting contact pushed during the step has v(t) set to v(t+dt) by the
+//    solver stage, i.e. symplectic Euler: it does not sink while held at
+//    rest, and momentum exchanged through contacts is conserved exactly.
 //  * Orientation: with L fixed over the step, the torque-free Euler equations
 //    are integrated for q by RK4. Integrating momenta, not omega, keeps L
 //    exactly constant in torque-free flight, so the gyroscopic (Dzhanibekov)
@@ -51,9 +55,9 @@ Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_prin
 void IntegrateForces(const Vec3& gravity, double dt, std::vector<Body>* bodies) {
   assert(dt > 0.0);
   for (Body& body : *bodies) {
-    if (!body.in_use || body.is_static) continue;
-    body.step_acceleration = gravity + body.inverse_mass * body.force;
-    body.linear_momentum += body.mass * body.step_acceleration * dt;
+    if (!body.in_use || body.is_static || !body.awake) continue;
+    body.start_linear_velocity = body.linear_velocity;
+    body.linear_momentum += (body.mass * gravity + body.force) * dt;
     body.angular_momentum += body.torque * dt;
     body.force.setZero();
     body.torque.setZero();
@@ -63,13 +67,24 @@ void IntegrateForces(const Vec3& gravity, double dt, std::vector<Body>* bodies) 
 
 void IntegratePositions(double dt, std::vector<Body>* bodies) {
   for (Body& body : *bodies) {
-    if (!body.in_use || body.is_static) continue;
-    body.position += dt * body.linear_velocity - 0.5 * dt * dt * body.step_acceleration;
+    if (!body.in_use || body.is_static || !body.awake) continue;
+    body.position += 0.5 * dt * (body.start_linear_velocity + body.linear_velocity) +
+                     dt * body.pseudo_linear_velocity;
     if (!body.angular_momentum.isZero(0.0)) {
       body.orientation = DriftOrientation(body.orientation, body.inverse_principal_moments,
                                           body.angular_momentum, dt);
     }
-    body.step_acceleration.setZero();
+    if (!body.pseudo_angular_velocity.isZero(0.0)) {
+      // The split-impulse rotation, a small angle applied as an exact rotation.
+      const Vec3 rotation_vector = dt * body.pseudo_angular_velocity;
+      body.orientation =
+          (Quat(Eigen::AngleAxisd(rotation_vector.norm(), rotation_vector.normalized())) *
+           body.orientation)
+              .normalized();
+    }
+    body.start_linear_velocity = body.linear_velocity;
+    body.pseudo_linear_velocity.setZero();
+    body.pseudo_angular_velocity.setZero();
     body.UpdateDerived();
   }
 }

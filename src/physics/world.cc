@@ -1,17 +1,22 @@
 #include "rigid_body_sim/physics/world.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <variant>
 
-#include "rigid_body_sim/physics/integrator.h"
+#include "rigid_body_sim/physics/shape_bounds.h"
 
 namespace rigid_body_sim::physics {
 namespace {
 
 constexpr double kUnitQuaternionTolerance = 1e-6;
+// Limits of the contact cache's keys.
+constexpr std::size_t kMaxShapesPerBody = 4096;
+constexpr std::size_t kMaxBodies = std::size_t{1} << 20;
 
 std::string Describe(const Vec3& v) {
   std::ostringstream out;
@@ -63,8 +68,12 @@ void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
   }
   body->force.setZero();
   body->torque.setZero();
-  body->step_acceleration.setZero();
+  body->pseudo_linear_velocity.setZero();
+  body->pseudo_angular_velocity.setZero();
+  body->awake = true;
+  body->sleep_time = 0.0;
   body->UpdateDerived();
+  body->start_linear_velocity = body->linear_velocity;
 }
 
 }  // namespace
@@ -76,6 +85,22 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
   if (!std::isfinite(settings.time_step) || settings.time_step <= 0.0) {
     return Status::Error("time_step must be positive and finite, got " +
                          std::to_string(settings.time_step));
+  }
+  if (!std::isfinite(settings.contact_margin) || settings.contact_margin < 0.0) {
+    return Status::Error("contact_margin must be finite and >= 0, got " +
+                         std::to_string(settings.contact_margin));
+  }
+  if (!(settings.continuous_fraction > 0.0 && settings.continuous_fraction <= 1.0)) {
+    return Status::Error("continuous_fraction must be in (0, 1], got " +
+                         std::to_string(settings.continuous_fraction));
+  }
+  const SleepSettings& sleep = settings.sleep;
+  if (!(sleep.linear_velocity >= 0.0) || !(sleep.angular_velocity >= 0.0) ||
+      !(sleep.time_to_sleep >= 0.0) || !std::isfinite(sleep.time_to_sleep)) {
+    return Status::Error("sleep thresholds must be finite and >= 0");
+  }
+  if (Status status = ValidateSolverSettings(settings.solver); !status.ok()) {
+    return Status::Error("solver: " + status.message());
   }
   return Status::Ok();
 }
@@ -101,10 +126,18 @@ Result<BodyId> World::CreateBody(const BodyDef& def) {
     if (Status status = ValidateShapeDef(shape); !status.ok()) {
       return Status::Error("shape " + std::to_string(i) + ": " + status.message());
     }
-    if (std::holds_alternative<HalfSpace>(shape.geometry) && !def.is_static) {
+    if (std::holds_alternative<HalfSpace>(shape.geometry) &&
+        (!def.is_static || def.shapes.size() != 1)) {
       return Status::Error("shape " + std::to_string(i) +
-                           ": a half-space may only belong to a static body");
+                           ": a half-space must be the only shape of a static body");
     }
+  }
+  if (def.shapes.size() > kMaxShapesPerBody) {
+    return Status::Error("a body may have at most " + std::to_string(kMaxShapesPerBody) +
+                         " shapes, got " + std::to_string(def.shapes.size()));
+  }
+  if (body_count_ >= kMaxBodies) {
+    return Status::Error("the world is full: " + std::to_string(kMaxBodies) + " bodies");
   }
 
   Body body;
@@ -124,6 +157,16 @@ Result<BodyId> World::CreateBody(const BodyDef& def) {
   }
   SetBodyState(def.world_from_body, def.linear_velocity, def.angular_velocity, &body);
   body.in_use = true;
+  body.thickness = std::numeric_limits<double>::infinity();
+  const Vec3 com_body = body.principal_from_body.Inverse().translation;
+  for (const ShapeDef& shape : body.shapes) {
+    // A half-space is unbounded; it is static, so its size never limits motion.
+    if (std::holds_alternative<HalfSpace>(shape.geometry)) continue;
+    body.thickness = std::min(body.thickness, ShapeThickness(shape.geometry));
+    body.bounding_radius = std::max(
+        body.bounding_radius,
+        ShapeBoundingRadius(shape.geometry, shape.body_from_shape.Inverse() * com_body));
+  }
 
   BodyId id;
   if (free_slots_.empty()) {
@@ -137,12 +180,22 @@ Result<BodyId> World::CreateBody(const BodyDef& def) {
   }
   id.generation = bodies_[id.index].generation;
   ++body_count_;
+  const Body& created = bodies_[id.index];
+  if (created.shapes.size() == 1 && std::holds_alternative<HalfSpace>(created.shapes[0].geometry)) {
+    half_space_bodies_.push_back(id.index);
+  }
   return id;
 }
 
 Status World::DestroyBody(BodyId id) {
   if (!IsValid(id)) return Status::Error("no body with this id");
   Body& body = bodies_[id.index];
+  if (body.has_proxy) broad_phase_.RemoveProxy(static_cast<int>(id.index));
+  contact_cache_.RemoveBody(id.index);
+  half_space_bodies_.erase(
+      std::remove(half_space_bodies_.begin(), half_space_bodies_.end(), id.index),
+      half_space_bodies_.end());
+  WakeTouching(id.index);
   const std::uint32_t next_generation = body.generation + 1;
   body = Body();
   body.generation = next_generation;
@@ -182,7 +235,16 @@ Status World::SetState(BodyId id, const Pose& world_from_body, const Vec3& linea
       !status.ok()) {
     return status;
   }
-  SetBodyState(world_from_body, linear_velocity, angular_velocity, &MutableBody(id));
+  Body& body = MutableBody(id);
+  SetBodyState(world_from_body, linear_velocity, angular_velocity, &body);
+  // Teleported: last step's contacts and impulses no longer apply, and
+  // whatever rested on the body must notice that it left.
+  WakeTouching(id.index);
+  contact_cache_.RemoveBody(id.index);
+  if (body.is_static && body.has_proxy) {
+    broad_phase_.RemoveProxy(static_cast<int>(id.index));
+    body.has_proxy = false;
+  }
   return Status::Ok();
 }
 
@@ -192,6 +254,7 @@ Status World::ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Vec3& 
   if (!IsFinite(point_world)) return Status::Error("point is not finite: " + Describe(point_world));
   Body& body = MutableBody(id);
   if (body.is_static) return Status::Ok();
+  Wake(id.index);
   body.force += force_world;
   body.torque += (point_world - body.position).cross(force_world);
   return Status::Ok();
@@ -204,14 +267,56 @@ Status World::ApplyTorque(BodyId id, const Vec3& torque_world) {
   }
   Body& body = MutableBody(id);
   if (body.is_static) return Status::Ok();
+  Wake(id.index);
   body.torque += torque_world;
   return Status::Ok();
 }
 
+void World::Restart() {
+  time_ = 0.0;
+  contacts_.clear();
+  collision_log_.clear();
+  contact_cache_.Clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_[i].in_use && !bodies_[i].is_static) Wake(i);
+  }
+}
+
+std::size_t World::AwakeBodyCount() const {
+  std::size_t count = 0;
+  for (const Body& body : bodies_) count += body.in_use && !body.is_static && body.awake;
+  return count;
+}
+
+void World::Wake(std::uint32_t index) {
+  Body& body = bodies_[index];
+  body.awake = true;
+  body.sleep_time = 0.0;
+}
+
+void World::WakeTouching(std::uint32_t index) {
+  for (const ContactReport& contact : contacts_) {
+    for (const BodyId other : {contact.body_a, contact.body_b}) {
+      if (other.index != index && IsValid(other) && !bodies_[other.index].is_static) {
+        Wake(other.index);
+      }
+    }
+  }
+}
+
+std::vector<ContactReport> World::TakeCollisionLog() {
+  std::vector<ContactReport> log;
+  log.swap(collision_log_);
+  return log;
+}
+
 void World::Step() {
   const double dt = settings_.time_step;
-  IntegrateForces(settings_.gravity, dt, &bodies_);
-  IntegratePositions(dt, &bodies_);
+  UpdateBroadPhase(dt);
+  UpdateNarrowPhase(dt);
+  UpdateContactCache();
+  SolveContacts(dt);
+  IntegrateBodies(dt);
   time_ += dt;
 }
 

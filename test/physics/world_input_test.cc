@@ -15,8 +15,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 BodyDef UnitBox() {
   BodyDef def;
   def.mass_properties = BoxMassProperties(1.0, Vec3(1, 1, 1));
-  def.shapes.push_back(ShapeDef{std::make_shared<const ConvexPolyhedron>(
-      MakeBoxPolyhedron(Vec3(1, 1, 1)))});
+  ShapeDef shape;
+  shape.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3(1, 1, 1)));
+  def.shapes.push_back(shape);
   def.world_from_body.translation = Vec3(0, 0, 1);
   return def;
 }

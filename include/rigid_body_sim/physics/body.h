@@ -45,10 +45,18 @@ struct Body {
 
   Vec3 force = Vec3::Zero();              // N, world, accumulated for the next step
   Vec3 torque = Vec3::Zero();             // N m, world, about the centre of mass
-  Vec3 step_acceleration = Vec3::Zero();  // m/s^2, external acceleration of the current step
+  Vec3 start_linear_velocity = Vec3::Zero();   // m/s, v before this step's forces
+  Vec3 pseudo_linear_velocity = Vec3::Zero();  // m/s, split-impulse correction of this step
+  Vec3 pseudo_angular_velocity = Vec3::Zero(); // rad/s
 
   std::vector<ShapeDef> shapes;           // in the body frame
+  double thickness = 0.0;        // m, smallest width of any shape; bounds motion per sample
+  double bounding_radius = 0.0;  // m, largest distance of any shape point from the centre of mass
+
   bool is_static = false;
+  bool awake = true;
+  double sleep_time = 0.0;       // s the body has been slow enough to sleep
+  bool has_proxy = false;        // registered with the broad phase
   std::uint64_t user_data = 0;
   std::uint32_t generation = 0;
   bool in_use = false;

@@ -25,12 +25,12 @@ struct ConvexPolyhedron {
     double offset = 0.0;         // m; plane: normal . x = offset
   };
 
-  std::vector<Vec3> vertices;             // m, shape frame, no duplicates
+  std::vector<Vec3> vertices;  // m, shape frame, no duplicates
   std::vector<HalfEdge> half_edges;
   std::vector<Face> faces;
-  std::vector<int> vertex_half_edge;      // one outgoing half-edge per vertex
-  std::vector<Vec3> edge_directions;      // unit directions of edges, unique up to sign
-  Vec3 centroid = Vec3::Zero();           // m, the volume centroid
+  std::vector<int> vertex_half_edge;  // one outgoing half-edge per vertex
+  std::vector<Vec3> edge_directions;  // unit directions of edges, unique up to sign
+  Vec3 centroid = Vec3::Zero();       // m, the volume centroid
 
   int EdgeCount() const { return static_cast<int>(half_edges.size() / 2); }
   static int Twin(int half_edge) { return half_edge ^ 1; }
@@ -48,6 +48,8 @@ struct ConvexPolyhedron {
 Result<ConvexPolyhedron> MakeConvexPolyhedron(const std::vector<Vec3>& vertices,
                                               const std::vector<std::vector<int>>& faces);
 
+// The builders below take validated parameters (asserted, not checked):
+// finite positive sizes, segments >= 3, density > 0.
 ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size);  // full edge lengths, m, centred
 // Prism with `segments` sides inscribed in the cylinder, axis z, centred.
 ConvexPolyhedron MakeCylinderPolyhedron(double radius, double length, int segments);

@@ -9,12 +9,13 @@
 
 namespace rigid_body_sim::physics {
 
-// Kick: P += (F + M g) dt and L += tau dt for every moving body, then clears
-// the force and torque accumulators. Records the external acceleration so the
-// drift can integrate it exactly.
+// Kick: P += (F + M g) dt and L += tau dt for every awake moving body, then
+// clears the force and torque accumulators. Records v before the kick for
+// the trapezoidal drift.
 void IntegrateForces(const Vec3& gravity, double dt, std::vector<Body>* bodies);
 
-// Drift: advances x and q over dt with the momenta the step ended with.
+// Drift: advances x and q over dt with the momenta the step ended with, plus
+// the split-impulse pseudo velocities.
 void IntegratePositions(double dt, std::vector<Body>* bodies);
 
 // Orientation after dt of torque-free motion with world angular momentum L

@@ -12,26 +12,26 @@ namespace rigid_body_sim::physics {
 // Mass, centre of mass and inertia tensor of a body, all expressed in the
 // frame the shapes were given in (the body frame, e.g. a URDF link frame).
 struct MassProperties {
-  double mass = 0.0;                         // kg
-  Vec3 center_of_mass = Vec3::Zero();        // m, in the body frame
-  Mat3 inertia_about_com = Mat3::Zero();     // kg m^2, about the centre of mass, body-frame axes
+  double mass = 0.0;                      // kg
+  Vec3 center_of_mass = Vec3::Zero();     // m, in the body frame
+  Mat3 inertia_about_com = Mat3::Zero();  // kg m^2, about the centre of mass, body-frame axes
 };
 
 // The inertia tensor diagonalised: inertia_about_com =
 // R diag(principal_moments) R^T with R = body_from_principal.
 struct PrincipalAxes {
-  Vec3 principal_moments = Vec3::Zero();     // kg m^2, ascending
+  Vec3 principal_moments = Vec3::Zero();  // kg m^2, ascending
   Quat body_from_principal = Quat::Identity();
 };
 
 // A closed, outward-oriented (counter-clockwise seen from outside) triangle mesh.
 struct TriangleMesh {
-  std::vector<Vec3> vertices;                // m
-  std::vector<Eigen::Vector3i> triangles;    // indices into vertices
+  std::vector<Vec3> vertices;              // m
+  std::vector<Eigen::Vector3i> triangles;  // indices into vertices
 };
 
-MassProperties BoxMassProperties(double density, const Vec3& size);            // size: full edge lengths, m
-MassProperties SphereMassProperties(double density, double radius);            // kg/m^3, m
+MassProperties BoxMassProperties(double density, const Vec3& size);  // size: full edge lengths, m
+MassProperties SphereMassProperties(double density, double radius);  // kg/m^3, m
 MassProperties CylinderMassProperties(double density, double radius, double length);  // axis = z
 
 // Exact volume integrals over a closed triangle mesh by the divergence

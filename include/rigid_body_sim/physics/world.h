@@ -6,14 +6,33 @@
 #include <vector>
 
 #include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/broad_phase.h"
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/contact_cache.h"
+#include "rigid_body_sim/physics/contact_solver.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::physics {
 
+struct SleepSettings {
+  bool enabled = true;
+  double linear_velocity = 0.05;   // m/s; slower bodies may sleep
+  double angular_velocity = 0.1;   // rad/s
+  double time_to_sleep = 0.5;      // s an island must stay slow before it sleeps
+};
+
 struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
   double time_step = 1.0 / 240.0;         // s, > 0
+  // m; bounding boxes are fattened by this, and contact points are reported
+  // while the surfaces are closer than this plus the pair's motion in a step.
+  double contact_margin = 0.005;
+  // A body moving more than this fraction of its thickness in one step is
+  // sampled along its path, so it cannot pass through anything (0, 1].
+  double continuous_fraction = 0.25;
+  SolverSettings solver;
+  SleepSettings sleep;
 };
 
 Status ValidateWorldSettings(const WorldSettings& settings);
@@ -32,6 +51,7 @@ class World {
   Status DestroyBody(BodyId id);
   bool IsValid(BodyId id) const;
   std::size_t BodyCount() const { return body_count_; }
+  std::size_t AwakeBodyCount() const;
 
   // Pose of the body frame and the velocity of its origin, world frame.
   Pose GetPose(BodyId id) const;
@@ -49,16 +69,47 @@ class World {
 
   // Advances the world by settings().time_step.
   void Step();
-  double time() const { return time_; }  // s since creation
+  double time() const { return time_; }  // s since creation or the last Restart
+
+  // Sets the time to 0 and forgets everything carried between steps (contact
+  // caches, warm starts, sleep timers); bodies keep their state.
+  void Restart();
+
+  // The contact points of the last step.
+  const std::vector<ContactReport>& contacts() const { return contacts_; }
+  // The colliding contacts of every step since the last call, so that short
+  // impacts are not lost between two reads.
+  std::vector<ContactReport> TakeCollisionLog();
 
  private:
   Body& MutableBody(BodyId id);
+  void Wake(std::uint32_t body);
+  // Wakes every body that touched `body` in the last step.
+  void WakeTouching(std::uint32_t body);
+
+  // The stages of Step, in order, one file each (step_*.cc).
+  void UpdateBroadPhase(double dt);   // 1. broad phase: swept boxes, candidate pairs
+  void UpdateNarrowPhase(double dt);  // 2. narrow phase: manifolds per shape pair
+  void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
+  void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
+  void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
+  void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  void UpdateSleep(double dt);
+  ContactReport MakeReport(const ShapePairContact& pair, int point, double dt) const;
 
   WorldSettings settings_;
   std::vector<Body> bodies_;       // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;
   double time_ = 0.0;
+  std::uint64_t step_count_ = 0;
+  SweepAndSortBroadPhase broad_phase_;
+  std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
+  ContactCache contact_cache_;
+  ContactSolver solver_;
+  std::vector<Pose> start_poses_;  // world_from_principal at the start of the step
+  std::vector<ContactReport> contacts_;
+  std::vector<ContactReport> collision_log_;
 };
 
 }  // namespace rigid_body_sim::physics

@@ -1,0 +1,71 @@
+// Stage 3 of a step: contacts carried from one step to the next.
+//
+// Per pair of shapes the broad phase reports, the cache keeps the separating
+// witness (Baraff's cached defining face or edge, seed 000 slide 13) and the
+// impulses of last step's contact points, so the narrow phase tests the
+// witness first and the solver starts from last step's impulses.
+#ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_CACHE_H_
+#define RIGID_BODY_SIM_PHYSICS_CONTACT_CACHE_H_
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "rigid_body_sim/physics/contact.h"
+
+namespace rigid_body_sim::physics {
+
+struct CachedImpulse {
+  FeatureId feature;
+  double normal_impulse = 0.0;                 // N s
+  std::array<double, 2> tangent_impulse{};     // N s, in the manifold's tangent basis
+};
+
+struct ShapePairContact {
+  std::uint32_t body_a = 0;  // body slot indices
+  std::uint32_t body_b = 0;
+  std::uint16_t shape_a = 0;
+  std::uint16_t shape_b = 0;
+  SeparatingWitness witness;
+  ContactManifold manifold;  // this step's
+  // Warm start for this step's points, matched by feature id.
+  std::array<CachedImpulse, ContactManifold::kMaxPoints> warm_start{};
+  // Last step's points and their final impulses.
+  std::array<CachedImpulse, ContactManifold::kMaxPoints> previous{};
+  int previous_count = 0;
+  std::uint64_t last_seen_step = 0;
+};
+
+class ContactCache {
+ public:
+  // The entry of a shape pair, created empty when new; marks it seen.
+  ShapePairContact& Touch(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
+                          std::uint16_t shape_b, std::uint64_t step);
+  // Drops the pairs not seen in `step` unless `asleep` says both of their
+  // bodies sleep (their contacts still hold, frozen), matches every touching
+  // manifold's points with last step's by feature id, and lists the pairs.
+  void MatchAndPrune(std::uint64_t step,
+                     const std::function<bool(const ShapePairContact&)>& asleep);
+  // Pairs with at least one contact point this step, in a deterministic order.
+  const std::vector<ShapePairContact*>& touching() const { return touching_; }
+  // Pairs of sleeping bodies, with the contacts and impulses they fell asleep with.
+  const std::vector<const ShapePairContact*>& sleeping() const { return sleeping_; }
+  // Forgets the pairs of one body (when it is destroyed or teleported).
+  void RemoveBody(std::uint32_t body);
+  void Clear();
+  std::size_t size() const { return pairs_.size(); }
+
+ private:
+  static std::uint64_t Key(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
+                           std::uint16_t shape_b);
+
+  std::unordered_map<std::uint64_t, ShapePairContact> pairs_;
+  std::vector<ShapePairContact*> touching_;
+  std::vector<const ShapePairContact*> sleeping_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_CONTACT_CACHE_H_

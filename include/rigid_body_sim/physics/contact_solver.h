@@ -1,0 +1,158 @@
+// Stage 4 of a step: contact dynamics.
+//
+// Baraff's order (seed 002, "Outline"): colliding contacts are resolved first
+// by impulses, on the velocities the step starts with; then the forces act
+// and resting contacts get the forces that keep them from penetrating. Both
+// are solved for all the contacts at once, as linear complementarity
+// problems at the velocity level (impulses over the step).
+#ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_SOLVER_H_
+#define RIGID_BODY_SIM_PHYSICS_CONTACT_SOLVER_H_
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+struct SolverSettings {
+  // PGS sweeps over the resting-contact rows per step.
+  int velocity_iterations = 20;
+  // Sweeps of the split-impulse position correction per step.
+  int position_iterations = 6;
+  // m/s; epsilon of the classification: colliding when v_r < -epsilon,
+  // resting when |v_r| <= epsilon.
+  double collision_velocity_threshold = 0.01;
+  // m; points closer than this are touching (the seed's numerical
+  // tolerance): only they collide or rest. Closer points are reached by the
+  // time-of-impact search, so the approach speed, and the bounce, is exact.
+  double contact_tolerance = 1e-5;
+  // m; penetration left alone, so resting contacts persist from step to step.
+  double penetration_slop = 0.5e-3;
+  // 1/step, in (0, 1]; fraction of the penetration beyond the slop removed per
+  // step by the split impulse. It moves positions only and adds no energy.
+  double position_correction = 0.2;
+  // Rounds of simultaneous collision impulses before the remaining colliding
+  // contacts are made perfectly inelastic.
+  int max_collision_rounds = 32;
+  // PGS sweeps within one collision round.
+  int collision_iterations = 30;
+  // Collision rounds with at most this many points solve the compression
+  // exactly by pivoting; larger ones by PGS.
+  int max_pivoting_points = 32;
+};
+
+Status ValidateSolverSettings(const SolverSettings& settings);
+
+// Velocities and inverse inertia of one body during the solve. Static and
+// sleeping bodies have zero inverse mass and inertia.
+struct SolverBody {
+  Vec3 linear_velocity = Vec3::Zero();   // m/s, of the centre of mass
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s
+  Vec3 pseudo_linear_velocity = Vec3::Zero();   // m/s, split-impulse correction
+  Vec3 pseudo_angular_velocity = Vec3::Zero();  // rad/s
+  double inverse_mass = 0.0;
+  Mat3 inverse_inertia_world = Mat3::Zero();
+};
+
+struct SolverPoint {
+  Vec3 r_a = Vec3::Zero();  // m, from A's centre of mass to the contact point
+  Vec3 r_b = Vec3::Zero();
+  double separation = 0.0;  // m
+  double normal_mass = 0.0;                  // 1 / (n . K n), kg
+  double tangent_mass = 0.0;                 // kg, the same along both tangents
+  double normal_velocity_before = 0.0;       // m/s, v_r at the start of the step
+  double normal_velocity_start = 0.0;        // m/s, v_r after the collisions, before the forces
+  double collision_impulse = 0.0;            // N s, from the collision phase
+  double normal_impulse = 0.0;               // N s, resting phase (warm-started)
+  std::array<double, 2> tangent_impulse{};   // N s, resting phase (warm-started)
+  double pseudo_impulse = 0.0;
+  ContactType type = ContactType::kSeparating;
+  FeatureId feature;
+};
+
+// One manifold: up to four points sharing a normal and a tangent basis.
+struct SolverManifold {
+  std::uint32_t body_a = 0;  // indices into the solver bodies
+  std::uint32_t body_b = 0;
+  Vec3 normal_world = Vec3::UnitZ();  // unit, from B to A
+  std::array<Vec3, 2> tangent_world{Vec3::UnitX(), Vec3::UnitY()};
+  double friction = 0.0;     // mu, combined
+  double restitution = 0.0;  // e, combined
+  int point_count = 0;
+  std::array<SolverPoint, ContactManifold::kMaxPoints> points;
+};
+
+// The tangent basis of a contact normal: a unit t1 orthogonal to n, and
+// t2 = n x t1. It depends on n only, so warm starts carry over.
+std::array<Vec3, 2> TangentBasis(const Vec3& normal);
+
+// Combination rules: e = max(ea, eb), mu = sqrt(mu_a mu_b).
+double CombineRestitution(double restitution_a, double restitution_b);
+double CombineFriction(double friction_a, double friction_b);
+
+class ContactSolver {
+ public:
+  // Starts a new step: keeps the arrays' memory, clears their contents.
+  void Reset(const SolverSettings& settings, double time_step, std::size_t body_count);
+
+  std::vector<SolverBody>& bodies() { return bodies_; }
+  std::vector<SolverManifold>& manifolds() { return manifolds_; }
+  const std::vector<SolverManifold>& manifolds() const { return manifolds_; }
+
+  // Computes the effective masses and the tangent basis of every point (r_a
+  // and r_b are set by the caller), and classifies each point by v_r before
+  // anything acts.
+  void Prepare();
+
+  // Colliding contact. Each round takes the points with v_r < -epsilon and
+  // finds compression impulses j_c >= 0 that stop them all at once
+  // (v_r+ >= 0, j_c v_r+ = 0, with Coulomb friction), then adds the
+  // restitution impulses e j_c (Poisson's hypothesis). For one point this is
+  // Baraff's impulse j = -(1+e) v_r- / (1/Ma + 1/Mb + n.(Ia^-1(ra x n)) x ra
+  // + n.(Ib^-1(rb x n)) x rb) (seed 000 slide 34); for several it never adds
+  // energy: dE = -(1 - e^2)/2 j_c.A j_c. Points that a round made colliding
+  // (a row of balls) are resolved in the next round.
+  void ResolveCollisions();
+
+  // Records v_r after the collisions and before the forces, which the
+  // resting contacts need for the trapezoidal drift.
+  void RecordStartVelocities();
+
+  // Resting contact at the velocity level, for the touching points:
+  // impulses f >= 0 with v_r+ >= target and f (v_r+ - target) = 0, with
+  // Coulomb friction |f_t| <= mu f_n in a circular cone, by projected
+  // Gauss-Seidel warm-started from last step's impulses. The target keeps the
+  // drift x += dt/2 (v_start + v_end) from entering the other body,
+  // target = min(0, -2 max(separation, 0)/dt - v_r,start), so a body that
+  // leaves the surface within the step flies free, and one held at rest is
+  // not pushed out (that is the split impulse's job). Then the split-impulse
+  // pseudo velocities that push penetrating contacts apart.
+  void SolveRestingContacts();
+
+  double time_step() const { return time_step_; }
+
+ private:
+  void ApplyImpulse(const SolverManifold& manifold, const SolverPoint& point,
+                    const Vec3& impulse_world);
+  double NormalVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
+  Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
+  bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
+                               std::vector<double>* normal);
+  // One PGS pass over the rows of the given points; returns the largest
+  // impulse change.
+  double CollisionSweep(const std::vector<std::pair<int, int>>& active,
+                        std::vector<double>* normal, std::vector<std::array<double, 2>>* tangent);
+
+  SolverSettings settings_;
+  double time_step_ = 1.0;
+  std::vector<SolverBody> bodies_;
+  std::vector<SolverManifold> manifolds_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_CONTACT_SOLVER_H_

@@ -1,0 +1,32 @@
+// Narrow phase: contact manifolds between two collision shapes.
+#ifndef RIGID_BODY_SIM_PHYSICS_NARROW_PHASE_H_
+#define RIGID_BODY_SIM_PHYSICS_NARROW_PHASE_H_
+
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/polyhedron_collision.h"
+#include "rigid_body_sim/physics/shape.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+struct CollideInput {
+  const ShapeGeometry* a = nullptr;
+  Pose world_from_a = Pose::Identity();
+  const ShapeGeometry* b = nullptr;
+  Pose world_from_b = Pose::Identity();
+  double contact_distance = 0.0;  // m: points with separation below this are contacts
+};
+
+// Contact manifold between shapes a and b, normal from b to a. Returns false
+// with manifold->point_count = 0 when they are separated by at least
+// contact_distance. `witness` is the per-pair cache of the separating or
+// contact-defining feature, owned by the caller (may be null; only used for
+// polyhedron pairs); `stats` (may be null) reports whether it was used.
+// Two half-spaces never collide (both are static); that pair is a
+// programmer error.
+bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManifold* manifold,
+             CollideStats* stats = nullptr);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_NARROW_PHASE_H_

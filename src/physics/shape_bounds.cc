@@ -1,0 +1,77 @@
+#include "rigid_body_sim/physics/shape_bounds.h"
+
+#include <algorithm>
+#include <cassert>
+#include <limits>
+#include <variant>
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// Up to this many vertices, transforming them all is cheaper than six
+// support queries.
+constexpr std::size_t kDirectAabbVertexCount = 16;
+
+Aabb PolyhedronAabb(const ConvexPolyhedron& polyhedron, const Pose& world_from_shape) {
+  if (polyhedron.vertices.size() <= kDirectAabbVertexCount) {
+    Aabb box{Vec3::Constant(std::numeric_limits<double>::infinity()),
+             Vec3::Constant(-std::numeric_limits<double>::infinity())};
+    for (const Vec3& vertex : polyhedron.vertices) {
+      const Vec3 vertex_world = world_from_shape * vertex;
+      box.min = box.min.cwiseMin(vertex_world);
+      box.max = box.max.cwiseMax(vertex_world);
+    }
+    return box;
+  }
+  // The extreme vertex along +-axis of the world is the support vertex along
+  // that axis expressed in the shape frame.
+  const Mat3 shape_from_world = world_from_shape.rotation.conjugate().toRotationMatrix();
+  Aabb box;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Vec3 axis_shape = shape_from_world.col(axis);
+    const Vec3& high = polyhedron.vertices[polyhedron.SupportVertex(axis_shape)];
+    const Vec3& low = polyhedron.vertices[polyhedron.SupportVertex(-axis_shape)];
+    box.max[axis] = (world_from_shape * high)[axis];
+    box.min[axis] = (world_from_shape * low)[axis];
+  }
+  return box;
+}
+
+}  // namespace
+
+Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape) {
+  if (const auto* sphere = std::get_if<Sphere>(&geometry)) {
+    const Vec3 radius = Vec3::Constant(sphere->radius);
+    return Aabb{world_from_shape.translation - radius, world_from_shape.translation + radius};
+  }
+  const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
+  assert(polyhedron != nullptr && *polyhedron != nullptr);
+  return PolyhedronAabb(**polyhedron, world_from_shape);
+}
+
+double ShapeThickness(const ShapeGeometry& geometry) {
+  if (const auto* sphere = std::get_if<Sphere>(&geometry)) return 2.0 * sphere->radius;
+  const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
+  if (polyhedron == nullptr) return std::numeric_limits<double>::infinity();
+  double thickness = std::numeric_limits<double>::infinity();
+  for (const ConvexPolyhedron::Face& face : (*polyhedron)->faces) {
+    const Vec3& opposite = (*polyhedron)->vertices[(*polyhedron)->SupportVertex(-face.normal)];
+    thickness = std::min(thickness, face.offset - face.normal.dot(opposite));
+  }
+  return thickness;
+}
+
+double ShapeBoundingRadius(const ShapeGeometry& geometry, const Vec3& center_shape) {
+  if (const auto* sphere = std::get_if<Sphere>(&geometry)) {
+    return center_shape.norm() + sphere->radius;
+  }
+  const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
+  if (polyhedron == nullptr) return std::numeric_limits<double>::infinity();
+  double radius = 0.0;
+  for (const Vec3& vertex : (*polyhedron)->vertices) {
+    radius = std::max(radius, (vertex - center_shape).norm());
+  }
+  return radius;
+}
+
+}  // namespace rigid_body_sim::physics

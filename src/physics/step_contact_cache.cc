@@ -1,0 +1,21 @@
+// Stage 3 of World::Step: match this step's contact points with last step's
+// for warm starting, forget vanished pairs, and wake sleeping bodies that an
+// awake body touches.
+#include "rigid_body_sim/physics/world.h"
+
+namespace rigid_body_sim::physics {
+
+void World::UpdateContactCache() {
+  contact_cache_.MatchAndPrune(step_count_, [this](const ShapePairContact& pair) {
+    const Body& a = bodies_[pair.body_a];
+    const Body& b = bodies_[pair.body_b];
+    return (a.is_static || !a.awake) && (b.is_static || !b.awake);
+  });
+  for (const ShapePairContact* pair : contact_cache_.touching()) {
+    Body& a = bodies_[pair->body_a];
+    Body& b = bodies_[pair->body_b];
+    if (!b.is_static && !b.awake && a.awake) Wake(pair->body_b);
+  }
+}
+
+}  // namespace rigid_body_sim::physics

@@ -1,0 +1,103 @@
+// Stability of stacks, pyramids and piles over seconds of simulated time.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "scene.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+using testing::AddBox;
+using testing::AddGround;
+using testing::BoxSpec;
+using testing::KineticEnergy;
+using testing::MakeMaterial;
+using testing::Translation;
+
+double MaxDrift(World* world, BodyId id, double seconds) {
+  const Vec3 start = world->GetPose(id).translation;
+  double drift = 0.0;
+  const int steps = static_cast<int>(std::lround(seconds / world->settings().time_step));
+  for (int step = 0; step < steps; ++step) {
+    world->Step();
+    drift = std::max(drift, (world->GetPose(id).translation - start).norm());
+  }
+  return drift;
+}
+
+TEST(StackingTest, TenBoxStackStands) {
+  World world;
+  AddGround(&world, MakeMaterial(0.5, 0.0));
+  BodyId top;
+  for (int i = 0; i < 10; ++i) {
+    BoxSpec spec;
+    spec.world_from_body = Translation(0, 0, 0.5 + i);
+    spec.material = MakeMaterial(0.5, 0.0);
+    top = AddBox(&world, spec);
+  }
+  EXPECT_LT(MaxDrift(&world, top, 10.0), 5e-3);
+}
+
+// 20 rows of unit boxes side by side, 210 in all.
+TEST(StackingTest, TwentyRowPyramidStands) {
+  World world;
+  AddGround(&world, MakeMaterial(0.6, 0.0));
+  const int rows = 20;
+  BodyId top;
+  for (int row = 0; row < rows; ++row) {
+    const int count = rows - row;
+    for (int i = 0; i < count; ++i) {
+      BoxSpec spec;
+      spec.world_from_body = Translation(i - 0.5 * (count - 1), 0, 0.5 + row);
+      spec.material = MakeMaterial(0.6, 0.0);
+      top = AddBox(&world, spec);
+    }
+  }
+  EXPECT_LT(MaxDrift(&world, top, 10.0), 1e-2);
+}
+
+// 1,000 unit boxes in a 10 x 10 grid of columns 1.1 m apart, layers 1.2 m
+// apart from z = 0.6, each layer yawed a further 0.1 rad, dropped on the
+// ground.
+TEST(StackingTest, ThousandBoxPileSettles) {
+  World world;
+  AddGround(&world, MakeMaterial(0.5, 0.0));
+  const int count = 1000;
+  const int side = static_cast<int>(std::ceil(std::cbrt(count)));
+  std::vector<BodyId> boxes;
+  for (int n = 0; n < count; ++n) {
+    const int layer = n / (side * side);
+    const int column = n % (side * side);
+    BoxSpec spec;
+    spec.world_from_body =
+        Translation(1.1 * (column % side - 0.5 * (side - 1)),
+                    1.1 * (column / side - 0.5 * (side - 1)), 0.6 + 1.2 * layer);
+    spec.world_from_body.rotation = Quat(Eigen::AngleAxisd(0.1 * layer, Vec3::UnitZ()));
+    spec.material = MakeMaterial(0.5, 0.0);
+    boxes.push_back(AddBox(&world, spec));
+  }
+  double max_depth = 0.0;
+  for (int step = 0; step < 240 * 10; ++step) {
+    world.Step();
+    for (const ContactReport& contact : world.contacts()) {
+      max_depth = std::max(max_depth, contact.depth);
+    }
+  }
+  double energy = 0.0;
+  double lowest_center = 1e9;
+  for (const BodyId id : boxes) {
+    energy += KineticEnergy(world.GetBody(id));
+    lowest_center = std::min(lowest_center, world.GetPose(id).translation.z());
+  }
+  EXPECT_TRUE(world.AwakeBodyCount() == 0 || energy < 1e-3)
+      << world.AwakeBodyCount() << " awake, kinetic energy " << energy << " J";
+  EXPECT_LT(max_depth, 5e-3);
+  // A unit box's centre is at least 0.5 m above the ground however it lies.
+  EXPECT_GT(lowest_center, 0.5 - 5e-3);
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::physics
