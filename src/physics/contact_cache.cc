@@ -32,6 +32,7 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
 void ContactCache::MatchAndPrune(std::uint64_t step,
                                  const std::function<bool(const ShapePairContact&)>& asleep) {
   touching_.clear();
+  seen_.clear();
   sleeping_.clear();
   for (auto it = pairs_.begin(); it != pairs_.end();) {
     ShapePairContact& entry = it->second;
@@ -54,6 +55,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step,
         }
       }
     }
+    seen_.push_back(&entry);
     if (entry.manifold.point_count > 0) {
       touching_.push_back(&entry);
     } else {
@@ -68,6 +70,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step,
            Key(y->body_a, y->shape_a, y->body_b, y->shape_b);
   };
   std::sort(touching_.begin(), touching_.end(), by_key);
+  std::sort(seen_.begin(), seen_.end(), by_key);
   std::sort(sleeping_.begin(), sleeping_.end(), by_key);
 }
 
@@ -80,12 +83,14 @@ void ContactCache::RemoveBody(std::uint32_t body) {
     }
   }
   touching_.clear();
+  seen_.clear();
   sleeping_.clear();
 }
 
 void ContactCache::Clear() {
   pairs_.clear();
   touching_.clear();
+  seen_.clear();
   sleeping_.clear();
 }
 

@@ -40,6 +40,25 @@ struct BodyPath {
 // Bisection stops when the bracket is shorter than this fraction of the step.
 constexpr double kTimeOfImpactTolerance = 1e-6;
 
+// Disjoint sets of body indices with path halving.
+class UnionFind {
+ public:
+  explicit UnionFind(std::size_t size) : parent_(size) {
+    std::iota(parent_.begin(), parent_.end(), 0u);
+  }
+  std::uint32_t Find(std::uint32_t i) {
+    while (parent_[i] != i) {
+      parent_[i] = parent_[parent_[i]];
+      i = parent_[i];
+    }
+    return i;
+  }
+  void Join(std::uint32_t a, std::uint32_t b) { parent_[Find(a)] = Find(b); }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+};
+
 }  // namespace
 
 // Time of impact by bisection (Baraff, seed 000 slide 4 and seed 002
@@ -64,8 +83,9 @@ void World::IntegrateBodies(double dt) {
     if (paths[i].dt > 0.0) paths[i].end = bodies_[i].WorldFromPrincipal();
   }
 
-  // Candidate pairs: a pair whose points were not yet touching at the start
-  // but may meet within the step, and every pair of a fast body.
+  // Candidate pairs: a pair with no touching point at the start (a new
+  // contact, which the solver has not seen), and every pair of a fast body.
+  // Pairs already touching are the resting solver's.
   const double touching = settings_.solver.contact_tolerance;
   const double target_gap = 0.5 * touching;
   auto is_fast = [&](std::uint32_t i) {
@@ -76,14 +96,17 @@ void World::IntegrateBodies(double dt) {
                               body.bounding_radius;
     return motion > settings_.continuous_fraction * body.thickness;
   };
+  // Each body is backed up to its own earliest impact. Backing up whole
+  // groups of linked impacts instead would let one grazing pair hold every
+  // body of a pile at the start of its step, step after step.
   std::vector<double> impact_time(bodies_.size(), std::numeric_limits<double>::infinity());
-  for (const ShapePairContact* pair : contact_cache_.touching()) {
-    bool approaching_gap = false;
+  for (const ShapePairContact* pair : contact_cache_.seen()) {
+    bool touching_at_start = false;
     for (int i = 0; i < pair->manifold.point_count; ++i) {
-      approaching_gap |= pair->manifold.points[i].separation > touching;
+      touching_at_start |= pair->manifold.points[i].separation <= touching;
     }
     const bool fast = is_fast(pair->body_a) || is_fast(pair->body_b);
-    if (!approaching_gap && !fast) continue;
+    if (touching_at_start && !fast) continue;
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
     const ShapeDef& shape_a = a.shapes[pair->shape_a];
@@ -134,13 +157,14 @@ void World::IntegrateBodies(double dt) {
     impact_time[pair->body_a] = std::min(impact_time[pair->body_a], low);
     impact_time[pair->body_b] = std::min(impact_time[pair->body_b], low);
   }
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (!std::isfinite(impact_time[i]) || paths[i].dt == 0.0) continue;
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const double time = impact_time[i];
+    if (!std::isfinite(time) || paths[i].dt == 0.0) continue;
     Body& body = bodies_[i];
-    const Pose pose = paths[i].At(impact_time[i]);
+    const Pose pose = paths[i].At(time);
     body.position = pose.translation;
     body.orientation = pose.rotation.normalized();
-    body.linear_momentum = body.mass * paths[i].VelocityAt(impact_time[i]);
+    body.linear_momentum = body.mass * paths[i].VelocityAt(time);
     body.UpdateDerived();
     body.start_linear_velocity = body.linear_velocity;
   }
@@ -153,20 +177,12 @@ void World::IntegrateBodies(double dt) {
 void World::UpdateSleep(double dt) {
   const SleepSettings& sleep = settings_.sleep;
   if (!sleep.enabled) return;
-  std::vector<std::uint32_t> parent(bodies_.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t i) {
-    while (parent[i] != i) {
-      parent[i] = parent[parent[i]];
-      i = parent[i];
-    }
-    return i;
-  };
+  UnionFind islands(bodies_.size());
   for (const ShapePairContact* pair : contact_cache_.touching()) {
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
     if (a.is_static || b.is_static) continue;
-    parent[find(pair->body_a)] = find(pair->body_b);
+    islands.Join(pair->body_a, pair->body_b);
   }
   std::vector<double> island_sleep_time(bodies_.size(), std::numeric_limits<double>::infinity());
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
@@ -177,13 +193,13 @@ void World::UpdateSleep(double dt) {
                       body.angular_velocity.squaredNorm() <
                           sleep.angular_velocity * sleep.angular_velocity;
     body.sleep_time = slow ? body.sleep_time + dt : 0.0;
-    double& island = island_sleep_time[find(i)];
+    double& island = island_sleep_time[islands.Find(i)];
     island = std::min(island, body.sleep_time);
   }
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& body = bodies_[i];
     if (!body.in_use || body.is_static || !body.awake) continue;
-    if (island_sleep_time[find(i)] < sleep.time_to_sleep) continue;
+    if (island_sleep_time[islands.Find(i)] < sleep.time_to_sleep) continue;
     body.awake = false;
     body.linear_momentum.setZero();
     body.angular_momentum.setZero();

@@ -50,6 +50,8 @@ class ContactCache {
                      const std::function<bool(const ShapePairContact&)>& asleep);
   // Pairs with at least one contact point this step, in a deterministic order.
   const std::vector<ShapePairContact*>& touching() const { return touching_; }
+  // Every pair the narrow phase looked at this step, touching or not.
+  const std::vector<ShapePairContact*>& seen() const { return seen_; }
   // Pairs of sleeping bodies, with the contacts and impulses they fell asleep with.
   const std::vector<const ShapePairContact*>& sleeping() const { return sleeping_; }
   // Forgets the pairs of one body (when it is destroyed or teleported).
@@ -63,6 +65,7 @@ class ContactCache {
 
   std::unordered_map<std::uint64_t, ShapePairContact> pairs_;
   std::vector<ShapePairContact*> touching_;
+  std::vector<ShapePairContact*> seen_;
   std::vector<const ShapePairContact*> sleeping_;
 };
 

@@ -31,7 +31,7 @@ struct SolverSettings {
   // time-of-impact search, so the approach speed, and the bounce, is exact.
   double contact_tolerance = 1e-5;
   // m; penetration left alone, so resting contacts persist from step to step.
-  double penetration_slop = 0.5e-3;
+  double penetration_slop = 1e-4;
   // 1/step, in (0, 1]; fraction of the penetration beyond the slop removed per
   // step by the split impulse. It moves positions only and adds no energy.
   double position_correction = 0.2;

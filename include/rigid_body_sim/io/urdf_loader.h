@@ -1,0 +1,70 @@
+// Rigid bodies from URDF models (urdfdom): links joined by fixed joints merge
+// into one body made of spheres and convex polyhedra.
+#ifndef RIGID_BODY_SIM_IO_URDF_LOADER_H_
+#define RIGID_BODY_SIM_IO_URDF_LOADER_H_
+
+#include <string>
+#include <vector>
+
+#include "rigid_body_sim/io/convex_hull.h"
+#include "rigid_body_sim/io/mesh_loader.h"
+#include "rigid_body_sim/physics/mass_properties.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/shape.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::io {
+
+struct UrdfLoadOptions {
+  // kg/m^3: density of links without <inertial>, whose mass properties are
+  // computed from their collision geometry.
+  double default_density = 1000.0;
+  HullOptions hull;            // for <mesh> collisions
+  int cylinder_segments = 32;  // count, >= 3: sides of the prism standing in for a <cylinder>
+  // Maps package:// and file:// URIs of meshes to local paths. When empty,
+  // ResolveFileUri is used, so package:// URIs are an error.
+  UriResolver resolver;
+};
+
+// One collision element of the model.
+struct LoadedShape {
+  physics::ShapeDef shape;          // body_from_shape is in the root-link frame
+  std::string link_name;            // the link the <collision> belongs to
+  bool friction_from_urdf = false;  // material.friction came from <gazebo><mu1>
+};
+
+// A link merged into the body and where it sits in it.
+struct LinkFrame {
+  std::string link_name;
+  physics::Pose root_from_link;
+};
+
+// One rigid body made of all links of a URDF model joined by fixed joints.
+// The body frame is the root link frame (the child of `world` for a static
+// model); the centre of mass is expressed in it.
+struct LoadedModel {
+  std::string name;                         // <robot name>
+  std::string root_link;                    // body frame
+  bool is_static = false;                   // fixed to a link named `world`
+  physics::Pose world_from_root;            // origin of the joint to `world`; identity if none
+  physics::MassProperties mass_properties;  // root-link frame; validated unless static
+  std::vector<LoadedShape> shapes;          // root-link frame
+  std::vector<LinkFrame> links;             // every link of the body, root first
+  std::vector<std::string> warnings;        // e.g. inertia computed from geometry
+};
+
+// Parses a URDF document. Fails, naming the element, on malformed XML,
+// unsupported or movable joints, invalid <inertial>, unreadable or degenerate
+// meshes, or a model without collision geometry. Relative mesh paths are
+// taken relative to the working directory.
+physics::Result<LoadedModel> LoadUrdfString(const std::string& xml,
+                                            const UrdfLoadOptions& options = {});
+
+// As LoadUrdfString, reading the file at `path`; relative mesh paths are
+// taken relative to the directory of the URDF file.
+physics::Result<LoadedModel> LoadUrdfFile(const std::string& path,
+                                          const UrdfLoadOptions& options = {});
+
+}  // namespace rigid_body_sim::io
+
+#endif  // RIGID_BODY_SIM_IO_URDF_LOADER_H_

@@ -1,0 +1,423 @@
+#include "rigid_body_sim/io/urdf_loader.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include <console_bridge/console.h>
+#include <tinyxml.h>
+#include <urdf_model/model.h>
+#include <urdf_parser/urdf_parser.h>
+
+namespace rigid_body_sim::io {
+namespace {
+
+using physics::ConvexPolyhedron;
+using physics::MassProperties;
+using physics::Mat3;
+using physics::Pose;
+using physics::Quat;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+constexpr char kWorldLink[] = "world";
+
+std::string Quoted(const std::string& text) { return "'" + text + "'"; }
+
+std::string FormatNumber(double value) {
+  std::ostringstream stream;
+  stream << value;
+  return stream.str();
+}
+
+// urdfdom reports why it rejects a document through console_bridge. While a
+// document is parsed, its messages are collected here so they can go into
+// the returned error instead of the process log. The output handler is
+// global, so parses are serialised.
+class ConsoleCapture : public console_bridge::OutputHandler {
+ public:
+  ConsoleCapture() : lock_(Mutex()) { console_bridge::useOutputHandler(this); }
+  ~ConsoleCapture() override { console_bridge::restorePreviousOutputHandler(); }
+  ConsoleCapture(const ConsoleCapture&) = delete;
+  ConsoleCapture& operator=(const ConsoleCapture&) = delete;
+
+  void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
+           int /*line*/) override {
+    if (level < console_bridge::CONSOLE_BRIDGE_LOG_WARN) return;
+    if (!text_.empty()) text_ += "; ";
+    text_ += text;
+  }
+  const std::string& text() const { return text_; }
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::string text_;
+};
+
+Pose ToPose(const urdf::Pose& pose) {
+  Quat rotation(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
+  rotation.normalize();
+  return Pose{Vec3(pose.position.x, pose.position.y, pose.position.z), rotation};
+}
+
+const char* JointTypeName(int type) {
+  switch (type) {
+    case urdf::Joint::REVOLUTE:
+      return "revolute";
+    case urdf::Joint::CONTINUOUS:
+      return "continuous";
+    case urdf::Joint::PRISMATIC:
+      return "prismatic";
+    case urdf::Joint::FLOATING:
+      return "floating";
+    case urdf::Joint::PLANAR:
+      return "planar";
+    case urdf::Joint::FIXED:
+      return "fixed";
+    default:
+      return "unknown";
+  }
+}
+
+// Friction coefficients from <gazebo reference="LINK"><mu1>, which urdfdom
+// does not read, so the XML is walked directly.
+Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& robot) {
+  std::map<std::string, double> friction;
+  for (const TiXmlElement* gazebo = robot.FirstChildElement("gazebo"); gazebo != nullptr;
+       gazebo = gazebo->NextSiblingElement("gazebo")) {
+    const char* reference = gazebo->Attribute("reference");
+    if (reference == nullptr) continue;
+    for (const TiXmlElement* mu = gazebo->FirstChildElement("mu1"); mu != nullptr;
+         mu = mu->NextSiblingElement("mu1")) {
+      const char* text = mu->GetText();
+      const std::string where = std::string("<gazebo reference=") + Quoted(reference) + "> <mu1>";
+      if (text == nullptr) {
+        return Result<std::map<std::string, double>>::Error(where + " is empty");
+      }
+      char* end = nullptr;
+      const double value = std::strtod(text, &end);
+      while (end != nullptr && std::isspace(static_cast<unsigned char>(*end))) ++end;
+      if (end == text || *end != '\0' || !std::isfinite(value) || value < 0.0) {
+        return Result<std::map<std::string, double>>::Error(where + " value " + Quoted(text) +
+                                                            " is not a finite non-negative number");
+      }
+      friction[reference] = value;
+    }
+  }
+  return friction;
+}
+
+// The link's <inertial> seen in the link frame, after checking it: mass > 0,
+// inertia finite, symmetric positive definite and obeying the triangle
+// inequality of principal moments.
+Result<MassProperties> InertialMassProperties(const urdf::Link& link) {
+  const urdf::Inertial& inertial = *link.inertial;
+  MassProperties in_inertial_frame;
+  in_inertial_frame.mass = inertial.mass;
+  in_inertial_frame.inertia_about_com << inertial.ixx, inertial.ixy, inertial.ixz,  //
+      inertial.ixy, inertial.iyy, inertial.iyz,                                     //
+      inertial.ixz, inertial.iyz, inertial.izz;
+  const Pose link_from_inertial = ToPose(inertial.origin);
+  const Status status = physics::ValidateMassProperties(in_inertial_frame);
+  if (!status.ok() || !link_from_inertial.translation.allFinite() ||
+      !physics::IsFinite(link_from_inertial.rotation)) {
+    const std::string reason = status.ok() ? "origin is not finite" : status.message();
+    return Result<MassProperties>::Error("link " + Quoted(link.name) +
+                                         ": invalid <inertial>: " + reason);
+  }
+  return physics::TransformMassProperties(in_inertial_frame, link_from_inertial);
+}
+
+bool PositiveFinite(double value) { return std::isfinite(value) && value > 0.0; }
+
+struct ShapeWithMass {
+  physics::ShapeGeometry geometry;
+  MassProperties mass_in_shape_frame;  // at the default density
+};
+
+// Builds one model; keeps caches across the links of that model.
+class ModelBuilder {
+ public:
+  ModelBuilder(const UrdfLoadOptions& options, UriResolver resolver)
+      : options_(options), resolver_(std::move(resolver)) {}
+
+  Result<LoadedModel> Build(const std::string& xml) {
+    TiXmlDocument document;
+    document.Parse(xml.c_str());
+    if (document.Error()) {
+      return Result<LoadedModel>::Error(
+          "malformed URDF XML at line " + std::to_string(document.ErrorRow()) + ", column " +
+          std::to_string(document.ErrorCol()) + ": " + document.ErrorDesc());
+    }
+    const TiXmlElement* robot = document.RootElement();
+    if (robot == nullptr || robot->ValueStr() != "robot") {
+      return Result<LoadedModel>::Error("URDF root element must be <robot>");
+    }
+    Result<std::map<std::string, double>> friction = ReadGazeboFriction(*robot);
+    if (!friction.ok()) return friction.status();
+    friction_ = std::move(friction).value();
+
+    urdf::ModelInterfaceSharedPtr model;
+    std::string parser_messages;
+    {
+      ConsoleCapture capture;
+      model = urdf::parseURDF(xml);
+      parser_messages = capture.text();
+    }
+    if (model == nullptr) {
+      return Result<LoadedModel>::Error("urdfdom rejected the URDF: " + (parser_messages.empty()
+                                                                             ? "no reason given"
+                                                                             : parser_messages));
+    }
+    return BuildModel(*model);
+  }
+
+ private:
+  Result<LoadedModel> BuildModel(const urdf::ModelInterface& model) {
+    for (const auto& [name, joint] : model.joints_) {
+      if (joint->type != urdf::Joint::FIXED) {
+        return Result<LoadedModel>::Error(
+            "joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
+            "; only fixed joints are supported, movable joints are not simulated yet");
+      }
+    }
+    for (const auto& [name, link] : model.links_) {
+      if (name == kWorldLink && link != model.getRoot()) {
+        return Result<LoadedModel>::Error("link 'world' must be the root of the model");
+      }
+    }
+
+    LoadedModel loaded;
+    loaded.name = model.getName();
+    urdf::LinkConstSharedPtr body_root = model.getRoot();
+    if (body_root->name == kWorldLink) {
+      loaded.is_static = true;
+      if (body_root->child_links.size() != 1) {
+        return Result<LoadedModel>::Error("link 'world' must have exactly one child link, has " +
+                                          std::to_string(body_root->child_links.size()));
+      }
+      if (!body_root->collision_array.empty() || body_root->inertial != nullptr) {
+        loaded.warnings.push_back(
+            "link 'world' stands for the fixed world; its <collision> and <inertial> are ignored");
+      }
+      const urdf::Joint& world_joint = *body_root->child_links.front()->parent_joint;
+      loaded.world_from_root = ToPose(world_joint.parent_to_joint_origin_transform);
+      body_root = body_root->child_links.front();
+    }
+    loaded.root_link = body_root->name;
+
+    std::vector<MassProperties> parts_in_root;
+    const Status status = AddLink(*body_root, Pose::Identity(), &loaded, &parts_in_root);
+    if (!status.ok()) return status;
+    if (loaded.shapes.empty()) {
+      return Result<LoadedModel>::Error("model " + Quoted(loaded.name) +
+                                        " has no <collision> elements");
+    }
+    loaded.mass_properties = physics::CombineMassProperties(parts_in_root);
+    if (!loaded.is_static) {
+      const Status mass_status = physics::ValidateMassProperties(loaded.mass_properties);
+      if (!mass_status.ok()) {
+        return Result<LoadedModel>::Error("model " + Quoted(loaded.name) +
+                                          " has invalid mass properties: " + mass_status.message());
+      }
+    }
+    return loaded;
+  }
+
+  // Adds `link` and, through their fixed joints, all links below it.
+  Status AddLink(const urdf::Link& link, const Pose& root_from_link, LoadedModel* loaded,
+                 std::vector<MassProperties>* parts_in_root) {
+    loaded->links.push_back(LinkFrame{link.name, root_from_link});
+    const auto friction = friction_.find(link.name);
+
+    std::vector<MassProperties> geometry_parts_in_link;
+    for (size_t i = 0; i < link.collision_array.size(); ++i) {
+      const urdf::Collision& collision = *link.collision_array[i];
+      const std::string where =
+          "link " + Quoted(link.name) + " <collision> " +
+          (collision.name.empty() ? std::to_string(i) : Quoted(collision.name));
+      if (collision.geometry == nullptr) return Status::Error(where + " has no <geometry>");
+      Result<ShapeWithMass> shape = MakeShape(*collision.geometry, where);
+      if (!shape.ok()) return shape.status();
+      const Pose link_from_shape = ToPose(collision.origin);
+      LoadedShape loaded_shape;
+      loaded_shape.shape.geometry = shape->geometry;
+      loaded_shape.shape.body_from_shape = root_from_link * link_from_shape;
+      loaded_shape.link_name = link.name;
+      if (friction != friction_.end()) {
+        loaded_shape.shape.material.friction = friction->second;
+        loaded_shape.friction_from_urdf = true;
+      }
+      loaded->shapes.push_back(std::move(loaded_shape));
+      geometry_parts_in_link.push_back(
+          physics::TransformMassProperties(shape->mass_in_shape_frame, link_from_shape));
+    }
+
+    if (link.inertial != nullptr) {
+      Result<MassProperties> inertial = InertialMassProperties(link);
+      if (!inertial.ok()) return inertial.status();
+      parts_in_root->push_back(physics::TransformMassProperties(*inertial, root_from_link));
+    } else if (!geometry_parts_in_link.empty()) {
+      // Overlapping collision elements count twice; a URDF that needs exact
+      // mass properties for overlapping geometry states its <inertial>.
+      parts_in_root->push_back(physics::TransformMassProperties(
+          physics::CombineMassProperties(geometry_parts_in_link), root_from_link));
+      if (!loaded->is_static) {
+        loaded->warnings.push_back("link " + Quoted(link.name) +
+                                   " has no <inertial>; mass computed from its collision "
+                                   "geometry at " +
+                                   FormatNumber(options_.default_density) + " kg/m^3");
+      }
+    }
+
+    for (const urdf::JointSharedPtr& joint : link.child_joints) {
+      urdf::LinkConstSharedPtr child;
+      for (const urdf::LinkSharedPtr& candidate : link.child_links) {
+        if (candidate->name == joint->child_link_name) child = candidate;
+      }
+      if (child == nullptr) {
+        return Status::Error("joint " + Quoted(joint->name) + " has no child link");
+      }
+      const Pose root_from_child = root_from_link * ToPose(joint->parent_to_joint_origin_transform);
+      const Status status = AddLink(*child, root_from_child, loaded, parts_in_root);
+      if (!status.ok()) return status;
+    }
+    return Status::Ok();
+  }
+
+  Result<ShapeWithMass> MakeShape(const urdf::Geometry& geometry, const std::string& where) {
+    const double density = options_.default_density;
+    switch (geometry.type) {
+      case urdf::Geometry::SPHERE: {
+        const double radius = static_cast<const urdf::Sphere&>(geometry).radius;
+        if (!PositiveFinite(radius)) {
+          return Result<ShapeWithMass>::Error(where + ": sphere radius must be positive, got " +
+                                              FormatNumber(radius));
+        }
+        return ShapeWithMass{physics::Sphere{radius},
+                             physics::SphereMassProperties(density, radius)};
+      }
+      case urdf::Geometry::BOX: {
+        const urdf::Vector3& dim = static_cast<const urdf::Box&>(geometry).dim;
+        const Vec3 size(dim.x, dim.y, dim.z);
+        if (!PositiveFinite(size.x()) || !PositiveFinite(size.y()) || !PositiveFinite(size.z())) {
+          return Result<ShapeWithMass>::Error(where + ": box size must be positive on every axis");
+        }
+        return ShapeWithMass{
+            std::make_shared<const ConvexPolyhedron>(physics::MakeBoxPolyhedron(size)),
+            physics::BoxMassProperties(density, size)};
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
+        if (!PositiveFinite(cylinder.radius) || !PositiveFinite(cylinder.length)) {
+          return Result<ShapeWithMass>::Error(where +
+                                              ": cylinder radius and length must be positive");
+        }
+        return ShapeWithMass{
+            std::make_shared<const ConvexPolyhedron>(physics::MakeCylinderPolyhedron(
+                cylinder.radius, cylinder.length, options_.cylinder_segments)),
+            physics::CylinderMassProperties(density, cylinder.radius, cylinder.length)};
+      }
+      case urdf::Geometry::MESH: {
+        const auto& mesh = static_cast<const urdf::Mesh&>(geometry);
+        const Vec3 scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+        Result<std::shared_ptr<const ConvexPolyhedron>> hull = MeshHull(mesh.filename, scale);
+        if (!hull.ok()) return Result<ShapeWithMass>::Error(where + ": " + hull.message());
+        return ShapeWithMass{*hull, physics::PolyhedronMassProperties(density, **hull)};
+      }
+    }
+    return Result<ShapeWithMass>::Error(where + ": unknown geometry type");
+  }
+
+  // Hull of a mesh file, shared by every collision element that uses the
+  // same file at the same scale.
+  Result<std::shared_ptr<const ConvexPolyhedron>> MeshHull(const std::string& uri,
+                                                           const Vec3& scale) {
+    const auto key = std::make_tuple(uri, scale.x(), scale.y(), scale.z());
+    const auto cached = hulls_.find(key);
+    if (cached != hulls_.end()) return cached->second;
+    Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_);
+    if (!mesh.ok()) return mesh.status();
+    Result<ConvexPolyhedron> hull = ComputeConvexHull(mesh->vertices, options_.hull);
+    if (!hull.ok()) {
+      return Result<std::shared_ptr<const ConvexPolyhedron>>::Error("mesh " + Quoted(uri) + ": " +
+                                                                    hull.message());
+    }
+    auto shared = std::make_shared<const ConvexPolyhedron>(std::move(hull).value());
+    hulls_.emplace(key, shared);
+    return std::shared_ptr<const ConvexPolyhedron>(shared);
+  }
+
+  const UrdfLoadOptions& options_;
+  UriResolver resolver_;
+  std::map<std::string, double> friction_;
+  std::map<std::tuple<std::string, double, double, double>, std::shared_ptr<const ConvexPolyhedron>>
+      hulls_;
+};
+
+Status ValidateOptions(const UrdfLoadOptions& options) {
+  if (!PositiveFinite(options.default_density)) {
+    return Status::Error("URDF load option default_density must be positive and finite, got " +
+                         FormatNumber(options.default_density));
+  }
+  if (options.cylinder_segments < 3) {
+    return Status::Error("URDF load option cylinder_segments must be at least 3, got " +
+                         std::to_string(options.cylinder_segments));
+  }
+  if (options.hull.max_vertices < 4) {
+    return Status::Error("URDF load option hull.max_vertices must be at least 4, got " +
+                         std::to_string(options.hull.max_vertices));
+  }
+  return Status::Ok();
+}
+
+UriResolver ResolverOrDefault(const UrdfLoadOptions& options) {
+  return options.resolver ? options.resolver : UriResolver(ResolveFileUri);
+}
+
+}  // namespace
+
+Result<LoadedModel> LoadUrdfString(const std::string& xml, const UrdfLoadOptions& options) {
+  const Status status = ValidateOptions(options);
+  if (!status.ok()) return status;
+  return ModelBuilder(options, ResolverOrDefault(options)).Build(xml);
+}
+
+Result<LoadedModel> LoadUrdfFile(const std::string& path, const UrdfLoadOptions& options) {
+  const Status status = ValidateOptions(options);
+  if (!status.ok()) return status;
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Result<LoadedModel>::Error("URDF file " + Quoted(path) + " cannot be read");
+  std::ostringstream contents;
+  contents << file.rdbuf();
+
+  // Relative mesh paths are relative to the URDF file.
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  UriResolver resolve = ResolverOrDefault(options);
+  UriResolver relative_to_file = [resolve,
+                                  directory](const std::string& uri) -> Result<std::string> {
+    Result<std::string> resolved = resolve(uri);
+    if (!resolved.ok() || std::filesystem::path(*resolved).is_absolute()) return resolved;
+    return (directory / *resolved).string();
+  };
+  Result<LoadedModel> model = ModelBuilder(options, relative_to_file).Build(contents.str());
+  if (!model.ok()) {
+    return Result<LoadedModel>::Error("URDF file " + Quoted(path) + ": " + model.message());
+  }
+  return model;
+}
+
+}  // namespace rigid_body_sim::io

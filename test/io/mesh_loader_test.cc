@@ -1,0 +1,149 @@
+#include "rigid_body_sim/io/mesh_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "polyhedron_checks.h"
+#include "rigid_body_sim/io/convex_hull.h"
+#include "rigid_body_sim/physics/convex_polyhedron.h"
+#include "rigid_body_sim/physics/mass_properties.h"
+
+namespace rigid_body_sim::io {
+namespace {
+
+using physics::Result;
+using physics::TriangleMesh;
+using physics::Vec3;
+
+const std::string kDataDir = RBS_TEST_DATA_DIR;
+
+// The shape of test/data/make_test_meshes.py: a 0.5 x 0.25 x 0.125 m box
+// with its (+x, +y, +z) corner cut 0.125, 0.0625 and 0.03125 m deep.
+const Vec3 kHalf(0.25, 0.125, 0.0625);
+const Vec3 kCut(0.125, 0.0625, 0.03125);
+const double kVolume = 8.0 * kHalf.prod() - kCut.prod() / 6.0;
+
+std::vector<Vec3> ReferenceVertices() {
+  std::vector<Vec3> vertices;
+  for (int i = 0; i < 7; ++i) {  // every corner but (+, +, +)
+    vertices.emplace_back(i & 4 ? kHalf.x() : -kHalf.x(), i & 2 ? kHalf.y() : -kHalf.y(),
+                          i & 1 ? kHalf.z() : -kHalf.z());
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    Vec3 cut_point = kHalf;
+    cut_point[axis] -= kCut[axis];
+    vertices.push_back(cut_point);
+  }
+  return vertices;
+}
+
+// Each reference vertex has a hull vertex within `tolerance` and the counts agree.
+void ExpectSameVertices(const std::vector<Vec3>& actual, const std::vector<Vec3>& expected,
+                        double tolerance) {
+  ASSERT_EQ(actual.size(), expected.size());
+  for (const Vec3& want : expected) {
+    double nearest = 1e300;
+    for (const Vec3& have : actual) nearest = std::min(nearest, (have - want).norm());
+    EXPECT_LE(nearest, tolerance) << "missing vertex " << want.transpose();
+  }
+}
+
+class MeshFormatTest : public ::testing::TestWithParam<const char*> {};
+
+// Every format holds the same shape: the mesh is closed and outward (its
+// signed volume is the analytic volume), and its hull has the 10 vertices
+// and 7 faces of the chamfered box.
+TEST_P(MeshFormatTest, LoadsTheChamferedBox) {
+  const std::string path = kDataDir + "/" + GetParam();
+  const Result<TriangleMesh> mesh = LoadMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  EXPECT_EQ(mesh->vertices.size(), 10u);   // identical vertices joined across sub-meshes
+  EXPECT_EQ(mesh->triangles.size(), 16u);  // 4 quads, 2 pentagons and a triangle
+  const Result<physics::MassProperties> mass = physics::TriangleMeshMassProperties(1.0, *mesh);
+  ASSERT_TRUE(mass.ok()) << mass.message();
+  EXPECT_NEAR(mass->mass, kVolume, 1e-12);
+
+  const Result<physics::ConvexPolyhedron> hull = ComputeConvexHull(mesh->vertices);
+  ASSERT_TRUE(hull.ok()) << hull.message();
+  EXPECT_EQ(hull->faces.size(), 7u);
+  ExpectSameVertices(hull->vertices, ReferenceVertices(), 1e-7);
+  EXPECT_NEAR(physics::PolyhedronMassProperties(1.0, *hull).mass, kVolume, 1e-12);
+  testing::ExpectValidConvexPolyhedron(*hull, 1e-12);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllFormats, MeshFormatTest,
+                         ::testing::Values("chamfered_box_ascii.stl", "chamfered_box_binary.stl",
+                                           "chamfered_box.obj", "chamfered_box.ply",
+                                           "chamfered_box_zup.dae", "chamfered_box_yup_cm.dae"));
+
+// The Y_UP centimetre DAE stores 100 * (x, z, -y); loading must undo both.
+TEST(MeshLoaderTest, DaeUnitAndUpAxisGiveMetresWithZUp) {
+  const Result<TriangleMesh> yup = LoadMesh(kDataDir + "/chamfered_box_yup_cm.dae");
+  const Result<TriangleMesh> zup = LoadMesh(kDataDir + "/chamfered_box_zup.dae");
+  ASSERT_TRUE(yup.ok()) << yup.message();
+  ASSERT_TRUE(zup.ok()) << zup.message();
+  ExpectSameVertices(yup->vertices, ReferenceVertices(), 1e-7);
+  ExpectSameVertices(zup->vertices, ReferenceVertices(), 1e-7);
+}
+
+TEST(MeshLoaderTest, ScaleIsAppliedAndMirroringKeepsTrianglesOutward) {
+  const Vec3 scale(2.0, 3.0, -0.5);
+  const Result<TriangleMesh> mesh = LoadMesh(kDataDir + "/chamfered_box.obj", scale);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  std::vector<Vec3> expected;
+  for (const Vec3& vertex : ReferenceVertices()) expected.push_back(vertex.cwiseProduct(scale));
+  ExpectSameVertices(mesh->vertices, expected, 1e-12);
+  const Result<physics::MassProperties> mass = physics::TriangleMeshMassProperties(1.0, *mesh);
+  ASSERT_TRUE(mass.ok()) << mass.message();
+  EXPECT_NEAR(mass->mass, kVolume * 3.0, 1e-12);  // |det scale| = 3
+}
+
+TEST(MeshLoaderTest, ResolvesFileAndPackageUris) {
+  EXPECT_TRUE(LoadMesh("file://" + kDataDir + "/chamfered_box.ply").ok());
+
+  const UriResolver resolver = [](const std::string& uri) -> Result<std::string> {
+    const std::string prefix = "package://rigid_body_sim/";
+    if (uri.rfind(prefix, 0) != 0) return Result<std::string>::Error("unknown package");
+    return std::string(RBS_SOURCE_DIR) + "/" + uri.substr(prefix.size());
+  };
+  const Result<TriangleMesh> mesh =
+      LoadMesh("package://rigid_body_sim/test/data/chamfered_box.ply", Vec3::Ones(), resolver);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  EXPECT_EQ(mesh->vertices.size(), 10u);
+
+  const Result<TriangleMesh> unresolved =
+      LoadMesh("package://rigid_body_sim/test/data/chamfered_box.ply");
+  ASSERT_FALSE(unresolved.ok());
+  EXPECT_NE(unresolved.message().find("package://rigid_body_sim/test/data/chamfered_box.ply"),
+            std::string::npos)
+      << unresolved.message();
+}
+
+// Each refusal names the offending file and the problem.
+TEST(MeshLoaderTest, BadFilesAreRefusedNamingTheFile) {
+  struct Case {
+    std::string file;
+    std::string problem;
+  };
+  const std::vector<Case> cases = {
+      {"missing.stl", "does not exist"},
+      {"chamfered_box.off", "unsupported format '.off'"},
+      {"empty.stl", "empty.stl"},
+      {"nan_vertex.stl", "not finite"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const Result<TriangleMesh> mesh = LoadMesh(kDataDir + "/" + c.file);
+    ASSERT_FALSE(mesh.ok());
+    EXPECT_NE(mesh.message().find(kDataDir + "/" + c.file), std::string::npos) << mesh.message();
+    EXPECT_NE(mesh.message().find(c.problem), std::string::npos) << mesh.message();
+  }
+  const Result<TriangleMesh> flat = LoadMesh(kDataDir + "/chamfered_box.obj", Vec3(1.0, 0.0, 1.0));
+  ASSERT_FALSE(flat.ok());
+  EXPECT_NE(flat.message().find("scale"), std::string::npos) << flat.message();
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::io
