@@ -12,8 +12,8 @@ void Body::UpdateDerived() {
     return;
   }
   const Mat3 world_from_principal = orientation.toRotationMatrix();
-  inverse_inertia_world =
-      world_from_principal * inverse_principal_moments.asDiagonal() * world_from_principal.transpose();
+  inverse_inertia_world = world_from_principal * inverse_principal_moments.asDiagonal() *
+                          world_from_principal.transpose();
   linear_velocity = inverse_mass * linear_momentum;
   angular_velocity = inverse_inertia_world * angular_momentum;
 }

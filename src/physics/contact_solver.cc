@@ -36,7 +36,8 @@ double TangentMass(const SolverBody& a, const SolverBody& b, const Vec3& r_a, co
                    const std::array<Vec3, 2>& tangent) {
   double trace = 0.0;
   for (const Vec3& t : tangent) {
-    trace += a.inverse_mass + b.inverse_mass + r_a.cross(t).dot(a.inverse_inertia_world * r_a.cross(t)) +
+    trace += a.inverse_mass + b.inverse_mass +
+             r_a.cross(t).dot(a.inverse_inertia_world * r_a.cross(t)) +
              r_b.cross(t).dot(b.inverse_inertia_world * r_b.cross(t));
   }
   return trace > 0.0 ? 2.0 / trace : 0.0;
@@ -174,7 +175,8 @@ double ContactSolver::CollisionSweep(const std::vector<std::pair<int, int>>& act
     ClampToDisc(manifold.friction * (*normal)[k], &(*tangent)[k]);
     const double dt0 = (*tangent)[k][0] - old_tangent[0];
     const double dt1 = (*tangent)[k][1] - old_tangent[1];
-    ApplyImpulse(manifold, point, dt0 * manifold.tangent_world[0] + dt1 * manifold.tangent_world[1]);
+    ApplyImpulse(manifold, point,
+                 dt0 * manifold.tangent_world[0] + dt1 * manifold.tangent_world[1]);
     largest_change = std::max({largest_change, std::abs(dt0), std::abs(dt1)});
   }
   return largest_change;
@@ -317,9 +319,8 @@ void ContactSolver::SolveRestingContacts() {
                        (point.tangent_impulse[0] - old_tangent[0]) * manifold.tangent_world[0] +
                            (point.tangent_impulse[1] - old_tangent[1]) * manifold.tangent_world[1]);
         }
-        const double target =
-            std::min(0.0, -2.0 * std::max(point.separation, 0.0) * inverse_dt -
-                              point.normal_velocity_start);
+        const double target = std::min(
+            0.0, -2.0 * std::max(point.separation, 0.0) * inverse_dt - point.normal_velocity_start);
         const double v_r = NormalVelocity(manifold, point);
         const double old_normal = point.normal_impulse;
         point.normal_impulse = std::max(0.0, old_normal + point.normal_mass * (target - v_r));

@@ -13,7 +13,8 @@ Aabb BodyAabb(const Body& body) {
   Aabb box = ShapeAabb(body.shapes.front().geometry,
                        world_from_body * body.shapes.front().body_from_shape);
   for (std::size_t i = 1; i < body.shapes.size(); ++i) {
-    box = box.Union(ShapeAabb(body.shapes[i].geometry, world_from_body * body.shapes[i].body_from_shape));
+    box = box.Union(
+        ShapeAabb(body.shapes[i].geometry, world_from_body * body.shapes[i].body_from_shape));
   }
   return box;
 }
@@ -29,7 +30,7 @@ void World::UpdateBroadPhase(double dt) {
   const double margin = settings_.contact_margin;
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& body = bodies_[i];
-    if (!body.in_use || body.shapes.empty() ||
+    if (!body.in_use || body.disabled || body.shapes.empty() ||
         std::holds_alternative<HalfSpace>(body.shapes.front().geometry)) {
       continue;
     }

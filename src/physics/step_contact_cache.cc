@@ -9,7 +9,7 @@ void World::UpdateContactCache() {
   contact_cache_.MatchAndPrune(step_count_, [this](const ShapePairContact& pair) {
     const Body& a = bodies_[pair.body_a];
     const Body& b = bodies_[pair.body_b];
-    return (a.is_static || !a.awake) && (b.is_static || !b.awake);
+    return (a.is_static || (!a.awake && !a.disabled)) && (b.is_static || (!b.awake && !b.disabled));
   });
   for (const ShapePairContact* pair : contact_cache_.touching()) {
     Body& a = bodies_[pair->body_a];

@@ -53,9 +53,8 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
                .Overlaps(ShapeAabb(shape_b.geometry, world_from_shape_b))) {
         continue;
       }
-      ShapePairContact& entry =
-          contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
-                               static_cast<std::uint16_t>(k), step_count_);
+      ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
+                                                     static_cast<std::uint16_t>(k), step_count_);
       CollideInput input;
       input.a = &shape_a.geometry;
       input.world_from_a = world_from_shape_a;

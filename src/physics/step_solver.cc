@@ -35,8 +35,7 @@ void StoreVelocities(const std::vector<SolverBody>& solver_bodies, std::vector<B
     const SolverBody& solver_body = solver_bodies[i];
     body.linear_momentum = body.mass * solver_body.linear_velocity;
     const Mat3 rotation = body.orientation.toRotationMatrix();
-    body.angular_momentum = rotation *
-                            body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+    body.angular_momentum = rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
                             (rotation.transpose() * solver_body.angular_velocity);
     body.pseudo_linear_velocity = solver_body.pseudo_linear_velocity;
     body.pseudo_angular_velocity = solver_body.pseudo_angular_velocity;
@@ -104,6 +103,7 @@ void World::SolveContacts(double dt) {
   solver_.RecordStartVelocities();
   StoreVelocities(solver_.bodies(), &bodies_);
   IntegrateForces(settings_.gravity, dt, &bodies_);
+  DisableNonFiniteBodies();
   LoadVelocities(bodies_, &solver_.bodies());
   solver_.SolveRestingContacts();
   StoreVelocities(solver_.bodies(), &bodies_);

@@ -34,8 +34,8 @@ Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
   }
   const double norm = world_from_body.rotation.norm();
   if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
-    return Status::Error("orientation quaternion is not unit length (norm " +
-                         std::to_string(norm) + ")");
+    return Status::Error("orientation quaternion is not unit length (norm " + std::to_string(norm) +
+                         ")");
   }
   if (!IsFinite(linear_velocity)) {
     return Status::Error("linear velocity is not finite: " + Describe(linear_velocity));
@@ -116,8 +116,7 @@ Status World::SetSettings(const WorldSettings& settings) {
 }
 
 Result<BodyId> World::CreateBody(const BodyDef& def) {
-  if (Status status = ValidateState(def.world_from_body, def.linear_velocity,
-                                    def.angular_velocity);
+  if (Status status = ValidateState(def.world_from_body, def.linear_velocity, def.angular_velocity);
       !status.ok()) {
     return status;
   }
@@ -163,9 +162,9 @@ Result<BodyId> World::CreateBody(const BodyDef& def) {
     // A half-space is unbounded; it is static, so its size never limits motion.
     if (std::holds_alternative<HalfSpace>(shape.geometry)) continue;
     body.thickness = std::min(body.thickness, ShapeThickness(shape.geometry));
-    body.bounding_radius = std::max(
-        body.bounding_radius,
-        ShapeBoundingRadius(shape.geometry, shape.body_from_shape.Inverse() * com_body));
+    body.bounding_radius =
+        std::max(body.bounding_radius,
+                 ShapeBoundingRadius(shape.geometry, shape.body_from_shape.Inverse() * com_body));
   }
 
   BodyId id;
@@ -236,6 +235,7 @@ Status World::SetState(BodyId id, const Pose& world_from_body, const Vec3& linea
     return status;
   }
   Body& body = MutableBody(id);
+  body.disabled = false;
   SetBodyState(world_from_body, linear_velocity, angular_velocity, &body);
   // Teleported: last step's contacts and impulses no longer apply, and
   // whatever rested on the body must notice that it left.
@@ -290,6 +290,7 @@ std::size_t World::AwakeBodyCount() const {
 
 void World::Wake(std::uint32_t index) {
   Body& body = bodies_[index];
+  if (body.disabled) return;
   body.awake = true;
   body.sleep_time = 0.0;
 }
@@ -312,6 +313,7 @@ std::vector<ContactReport> World::TakeCollisionLog() {
 
 void World::Step() {
   const double dt = settings_.time_step;
+  non_finite_bodies_.clear();
   UpdateBroadPhase(dt);
   UpdateNarrowPhase(dt);
   UpdateContactCache();

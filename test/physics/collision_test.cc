@@ -123,8 +123,7 @@ TEST(CollisionTest, CornerImpactMatchesSeedFormula) {
       lowest_corner_body = corner_body;
     }
   }
-  spec.world_from_body.translation =
-      Vec3(0, 0, -lowest + 0.5 * settings.solver.contact_tolerance);
+  spec.world_from_body.translation = Vec3(0, 0, -lowest + 0.5 * settings.solver.contact_tolerance);
   const BodyId box = AddBox(&world, spec);
 
   // By hand.
@@ -135,8 +134,8 @@ TEST(CollisionTest, CornerImpactMatchesSeedFormula) {
   const Vec3 n = Vec3::UnitZ();
   const double v_r = n.dot(spec.linear_velocity + spec.angular_velocity.cross(r));
   ASSERT_LT(v_r, -0.1);
-  const double j = -(1.0 + e) * v_r /
-                   (1.0 / spec.mass + n.dot((inverse_inertia_world * r.cross(n)).cross(r)));
+  const double j =
+      -(1.0 + e) * v_r / (1.0 / spec.mass + n.dot((inverse_inertia_world * r.cross(n)).cross(r)));
   const Vec3 expected_momentum = spec.mass * spec.linear_velocity + j * n;
   const Vec3 expected_angular_momentum =
       inverse_inertia_world.inverse() * spec.angular_velocity + r.cross(j * n);
@@ -232,8 +231,7 @@ TEST_P(ConservationTest, OffCentreCollisionConservesMomentum) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, ConservationTest,
                          ::testing::Values(ConservationCase{1.0, 0.0}, ConservationCase{0.5, 0.0},
-                                           ConservationCase{0.0, 0.0},
-                                           ConservationCase{0.8, 0.4}));
+                                           ConservationCase{0.0, 0.0}, ConservationCase{0.8, 0.4}));
 
 // Newton's cradle: five touching balls with e = 1, the first arriving at
 // 1 m/s. Collisions propagate round by round, so the last ball leaves with

@@ -31,8 +31,8 @@ inline BodyId AddGround(World* world, const Material& material,
 }
 
 struct BoxSpec {
-  Vec3 size = Vec3::Ones();   // m, full edge lengths
-  double mass = 1.0;          // kg
+  Vec3 size = Vec3::Ones();  // m, full edge lengths
+  double mass = 1.0;         // kg
   Pose world_from_body;
   Vec3 linear_velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();

@@ -61,7 +61,9 @@ TEST(StackingTest, TwentyRowPyramidStands) {
 
 // 1,000 unit boxes in a 10 x 10 grid of columns 1.1 m apart, layers 1.2 m
 // apart from z = 0.6, each layer yawed a further 0.1 rad, dropped on the
-// ground.
+// ground (the benchmark's pile_1000). Boxes yawed near 45 degrees overlap
+// their neighbours as placed, so penetration is measured once settled, over
+// the last second.
 TEST(StackingTest, ThousandBoxPileSettles) {
   World world;
   AddGround(&world, MakeMaterial(0.5, 0.0));
@@ -72,9 +74,8 @@ TEST(StackingTest, ThousandBoxPileSettles) {
     const int layer = n / (side * side);
     const int column = n % (side * side);
     BoxSpec spec;
-    spec.world_from_body =
-        Translation(1.1 * (column % side - 0.5 * (side - 1)),
-                    1.1 * (column / side - 0.5 * (side - 1)), 0.6 + 1.2 * layer);
+    spec.world_from_body = Translation(1.1 * (column % side - 0.5 * (side - 1)),
+                                       1.1 * (column / side - 0.5 * (side - 1)), 0.6 + 1.2 * layer);
     spec.world_from_body.rotation = Quat(Eigen::AngleAxisd(0.1 * layer, Vec3::UnitZ()));
     spec.material = MakeMaterial(0.5, 0.0);
     boxes.push_back(AddBox(&world, spec));
@@ -82,6 +83,7 @@ TEST(StackingTest, ThousandBoxPileSettles) {
   double max_depth = 0.0;
   for (int step = 0; step < 240 * 10; ++step) {
     world.Step();
+    if (step < 240 * 9) continue;
     for (const ContactReport& contact : world.contacts()) {
       max_depth = std::max(max_depth, contact.depth);
     }

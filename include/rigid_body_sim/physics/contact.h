@@ -26,8 +26,8 @@ struct FeatureId {
   std::uint16_t index_b = 0;
 
   std::uint32_t Key() const {
-    return (static_cast<std::uint32_t>(type) << 30) ^
-           (static_cast<std::uint32_t>(index_a) << 15) ^ static_cast<std::uint32_t>(index_b);
+    return (static_cast<std::uint32_t>(type) << 30) ^ (static_cast<std::uint32_t>(index_a) << 15) ^
+           static_cast<std::uint32_t>(index_b);
   }
   friend bool operator==(FeatureId x, FeatureId y) {
     return x.type == y.type && x.index_a == y.index_a && x.index_b == y.index_b;
@@ -69,16 +69,16 @@ enum class ContactType : std::uint8_t {
 struct ContactReport {
   BodyId body_a;
   BodyId body_b;
-  int shape_a = 0;                      // index into body A's shapes
+  int shape_a = 0;  // index into body A's shapes
   int shape_b = 0;
-  Vec3 position_world = Vec3::Zero();   // m
-  Vec3 normal_world = Vec3::UnitZ();    // unit, from B towards A
-  double depth = 0.0;                   // m, penetration, >= 0
-  double normal_velocity = 0.0;         // m/s, v_r before resolution; < 0 approaching
+  Vec3 position_world = Vec3::Zero();  // m
+  Vec3 normal_world = Vec3::UnitZ();   // unit, from B towards A
+  double depth = 0.0;                  // m, penetration, >= 0
+  double normal_velocity = 0.0;        // m/s, v_r before resolution; < 0 approaching
   ContactType type = ContactType::kResting;
-  double normal_impulse = 0.0;          // N s, along the normal, in the step it was resolved
+  double normal_impulse = 0.0;                 // N s, along the normal, in the step it was resolved
   Vec3 friction_impulse_world = Vec3::Zero();  // N s
-  double normal_force = 0.0;            // N, normal_impulse / time_step
+  double normal_force = 0.0;                   // N, normal_impulse / time_step
 };
 
 }  // namespace rigid_body_sim::physics

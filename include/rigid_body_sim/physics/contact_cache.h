@@ -19,8 +19,8 @@ namespace rigid_body_sim::physics {
 
 struct CachedImpulse {
   FeatureId feature;
-  double normal_impulse = 0.0;                 // N s
-  std::array<double, 2> tangent_impulse{};     // N s, in the manifold's tangent basis
+  double normal_impulse = 0.0;              // N s
+  std::array<double, 2> tangent_impulse{};  // N s, in the manifold's tangent basis
 };
 
 struct ShapePairContact {

@@ -50,8 +50,8 @@ Status ValidateSolverSettings(const SolverSettings& settings);
 // Velocities and inverse inertia of one body during the solve. Static and
 // sleeping bodies have zero inverse mass and inertia.
 struct SolverBody {
-  Vec3 linear_velocity = Vec3::Zero();   // m/s, of the centre of mass
-  Vec3 angular_velocity = Vec3::Zero();  // rad/s
+  Vec3 linear_velocity = Vec3::Zero();          // m/s, of the centre of mass
+  Vec3 angular_velocity = Vec3::Zero();         // rad/s
   Vec3 pseudo_linear_velocity = Vec3::Zero();   // m/s, split-impulse correction
   Vec3 pseudo_angular_velocity = Vec3::Zero();  // rad/s
   double inverse_mass = 0.0;
@@ -61,14 +61,14 @@ struct SolverBody {
 struct SolverPoint {
   Vec3 r_a = Vec3::Zero();  // m, from A's centre of mass to the contact point
   Vec3 r_b = Vec3::Zero();
-  double separation = 0.0;  // m
-  double normal_mass = 0.0;                  // 1 / (n . K n), kg
-  double tangent_mass = 0.0;                 // kg, the same along both tangents
-  double normal_velocity_before = 0.0;       // m/s, v_r at the start of the step
-  double normal_velocity_start = 0.0;        // m/s, v_r after the collisions, before the forces
-  double collision_impulse = 0.0;            // N s, from the collision phase
-  double normal_impulse = 0.0;               // N s, resting phase (warm-started)
-  std::array<double, 2> tangent_impulse{};   // N s, resting phase (warm-started)
+  double separation = 0.0;                  // m
+  double normal_mass = 0.0;                 // 1 / (n . K n), kg
+  double tangent_mass = 0.0;                // kg, the same along both tangents
+  double normal_velocity_before = 0.0;      // m/s, v_r at the start of the step
+  double normal_velocity_start = 0.0;       // m/s, v_r after the collisions, before the forces
+  double collision_impulse = 0.0;           // N s, from the collision phase
+  double normal_impulse = 0.0;              // N s, resting phase (warm-started)
+  std::array<double, 2> tangent_impulse{};  // N s, resting phase (warm-started)
   double pseudo_impulse = 0.0;
   ContactType type = ContactType::kSeparating;
   FeatureId feature;
@@ -144,8 +144,8 @@ class ContactSolver {
                                std::vector<double>* normal);
   // One PGS pass over the rows of the given points; returns the largest
   // impulse change.
-  double CollisionSweep(const std::vector<std::pair<int, int>>& active,
-                        std::vector<double>* normal, std::vector<std::array<double, 2>>* tangent);
+  double CollisionSweep(const std::vector<std::pair<int, int>>& active, std::vector<double>* normal,
+                        std::vector<std::array<double, 2>>* tangent);
 
   SolverSettings settings_;
   double time_step_ = 1.0;

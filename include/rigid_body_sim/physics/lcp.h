@@ -24,8 +24,8 @@ struct LcpSolution {
 Result<LcpSolution> SolveLcpLemke(const Eigen::MatrixXd& a, const Eigen::VectorXd& b);
 
 struct PgsSettings {
-  int max_iterations = 200;   // sweeps
-  double tolerance = 1e-12;   // stop when no unknown changes by more than this (units of f)
+  int max_iterations = 200;  // sweeps
+  double tolerance = 1e-12;  // stop when no unknown changes by more than this (units of f)
 };
 
 // Projected Gauss-Seidel: f_i <- max(0, f_i - (b_i + A_i. f) / A_ii), sweeping

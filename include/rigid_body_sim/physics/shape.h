@@ -18,8 +18,7 @@ struct Sphere {
 struct HalfSpace {};
 
 // Polyhedra are immutable and shared, so many bodies can use one hull.
-using ShapeGeometry =
-    std::variant<Sphere, std::shared_ptr<const ConvexPolyhedron>, HalfSpace>;
+using ShapeGeometry = std::variant<Sphere, std::shared_ptr<const ConvexPolyhedron>, HalfSpace>;
 
 struct Material {
   double friction = 0.5;     // Coulomb coefficient mu, dimensionless, >= 0

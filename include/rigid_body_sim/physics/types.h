@@ -18,8 +18,8 @@ using Quat = Eigen::Quaterniond;
 // A rigid transform: `Pose a_from_b` maps coordinates in frame b to frame a,
 // p_a = rotation * p_b + translation.
 struct Pose {
-  Vec3 translation = Vec3::Zero();       // m
-  Quat rotation = Quat::Identity();      // unit quaternion
+  Vec3 translation = Vec3::Zero();   // m
+  Quat rotation = Quat::Identity();  // unit quaternion
 
   static Pose Identity() { return Pose{}; }
   Vec3 operator*(const Vec3& p) const { return rotation * p + translation; }

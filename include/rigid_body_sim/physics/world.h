@@ -17,14 +17,14 @@ namespace rigid_body_sim::physics {
 
 struct SleepSettings {
   bool enabled = true;
-  double linear_velocity = 0.05;   // m/s; slower bodies may sleep
-  double angular_velocity = 0.1;   // rad/s
-  double time_to_sleep = 0.5;      // s an island must stay slow before it sleeps
+  double linear_velocity = 0.05;  // m/s; slower bodies may sleep
+  double angular_velocity = 0.1;  // rad/s
+  double time_to_sleep = 0.5;     // s an island must stay slow before it sleeps
 };
 
 struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
-  double time_step = 1.0 / 240.0;         // s, > 0
+  double time_step = 1.0 / 240.0;        // s, > 0
   // m; bounding boxes are fattened by this, and contact points are reported
   // while the surfaces are closer than this plus the pair's motion in a step.
   double contact_margin = 0.005;
@@ -75,6 +75,11 @@ class World {
   // caches, warm starts, sleep timers); bodies keep their state.
   void Restart();
 
+  // Bodies whose state became non-finite in the last step (e.g. forces that
+  // overflowed). They are taken out of the simulation, so no NaN reaches
+  // their neighbours, until SetState gives them a finite state again.
+  const std::vector<BodyId>& non_finite_bodies() const { return non_finite_bodies_; }
+
   // The contact points of the last step.
   const std::vector<ContactReport>& contacts() const { return contacts_; }
   // The colliding contacts of every step since the last call, so that short
@@ -95,10 +100,11 @@ class World {
   void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
   void UpdateSleep(double dt);
+  void DisableNonFiniteBodies();
   ContactReport MakeReport(const ShapePairContact& pair, int point, double dt) const;
 
   WorldSettings settings_;
-  std::vector<Body> bodies_;       // slots; a destroyed body's slot is reused
+  std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;
   double time_ = 0.0;
@@ -110,6 +116,7 @@ class World {
   std::vector<Pose> start_poses_;  // world_from_principal at the start of the step
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
+  std::vector<BodyId> non_finite_bodies_;
 };
 
 }  // namespace rigid_body_sim::physics
