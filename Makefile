@@ -14,11 +14,19 @@ CMAKE_ARGS ?=
 CATKIN := catkin_make -C $(WS) -DPYTHON_EXECUTABLE=/usr/bin/python3 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_ARGS)
 
-.PHONY: demo test deps build test-sanitize bench clean format
+.PHONY: demo test deps build test-sanitize test-tsan bench clean format
 
+# The demo scene without rviz for DEMO_SECONDS of real time, showing the
+# node's log (its status line comes every 5 s). Succeeds when the node
+# logged at least one status line.
+DEMO_SECONDS ?= 20
 demo: build
-	@echo "[demo] dropping a few bodies"
-	$(WS)/devel/lib/rigid_body_sim/drop_demo
+	@echo "[demo] roslaunch rigid_body_sim demo.launch for $(DEMO_SECONDS) s (rviz:=true adds rviz)"
+	@set +e; source $(WS)/devel/setup.bash; \
+	  timeout --signal=INT --kill-after=10 $(DEMO_SECONDS) roslaunch rigid_body_sim demo.launch 2>&1 \
+	  | sed -u 's/\x1b\[[0-9;]*m//g' | grep --line-buffered -E '^\[ *(INFO|WARN|ERROR|FATAL)\]' \
+	  | tee $(WS)/demo.log; \
+	  grep -q 'sim time' $(WS)/demo.log
 
 test: build
 	@echo "[test] building the tests"
@@ -47,8 +55,27 @@ test-sanitize: deps
 	cd $(CORE_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure
 
+# The concurrency rostest with the node and its client built under
+# ThreadSanitizer in a second workspace; any report fails the target.
+WS_TSAN := $(ROOT)/.ws-tsan
+test-tsan: deps
+	mkdir -p $(WS_TSAN)/src
+	ln -sfn $(ROOT) $(WS_TSAN)/src/rigid_body_sim
+	catkin_make -C $(WS_TSAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
+	  -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread $(CMAKE_ARGS) \
+	  rigid_body_sim_node node_concurrency_test -j$(JOBS) 2>&1 \
+	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|error|warning' || true)
+	rm -f $(WS_TSAN)/tsan.*
+	source $(WS_TSAN)/devel/setup.bash && \
+	  TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(ROOT)/test/node/tsan.supp log_path=$(WS_TSAN)/tsan" \
+	  rostest $(ROOT)/test/node/node_concurrency_test.test
+	@if ls $(WS_TSAN)/tsan.* > /dev/null 2>&1; then \
+	  cat $(WS_TSAN)/tsan.*; echo "[test-tsan] ThreadSanitizer reported a race" >&2; exit 1; fi
+	@echo "[test-tsan] no ThreadSanitizer reports"
+
 clean:
-	rm -rf $(WS) $(ROOT)/build
+	rm -rf $(WS) $(WS_TSAN) $(ROOT)/build
 
 format:
 	clang-format -i $$(git ls-files '*.h' '*.cc')

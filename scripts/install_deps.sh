@@ -11,6 +11,7 @@ packages=(
   libassimp-dev libqhull-dev libeigen3-dev
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
   libbullet-dev libbenchmark-dev python3-matplotlib
+  libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
 )
 
 missing=()

@@ -26,7 +26,8 @@ int main() {
   for (int step = 0; step <= 120; ++step) {
     if (step % 24 == 0) {
       std::printf("%6.2f", world.time());
-      for (const physics::BodyId id : bodies) std::printf(" %10.4f", world.GetPose(id).translation.z());
+      for (const physics::BodyId id : bodies)
+        std::printf(" %10.4f", world.GetPose(id).translation.z());
       std::printf("\n");
     }
     world.Step();

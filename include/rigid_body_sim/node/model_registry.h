@@ -1,0 +1,108 @@
+// The node's models: what a spawn asks for, how a loaded URDF becomes a body,
+// and the registry of spawned models by name. ROS-free.
+#ifndef RIGID_BODY_SIM_NODE_MODEL_REGISTRY_H_
+#define RIGID_BODY_SIM_NODE_MODEL_REGISTRY_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "rigid_body_sim/io/urdf_loader.h"
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::node {
+
+// Pose and twist of a frame in the world frame. The twist is the velocity of
+// the frame's origin plus the angular velocity.
+struct FrameState {
+  physics::Pose world_from_frame;
+  physics::Vec3 linear_velocity = physics::Vec3::Zero();   // m/s, world
+  physics::Vec3 angular_velocity = physics::Vec3::Zero();  // rad/s, world
+};
+
+// What a caller asks to spawn, from the Spawn service or the ~models parameter.
+struct ModelSpec {
+  std::string name;       // [A-Za-z_][A-Za-z0-9_]*
+  std::string urdf;       // URDF XML; when empty, urdf_path is read
+  std::string urdf_path;  // file path, file:// or package:// URI
+  FrameState root_state;  // of the root link
+  bool is_static = false;
+  double friction = -1.0;     // >= 0 overrides every shape; < 0: URDF or the default
+  double restitution = -1.0;  // >= 0 overrides every shape; < 0: the default
+};
+
+// Materials of shapes the spec and the URDF leave open.
+struct MaterialDefaults {
+  double friction = 0.5;     // Coulomb mu, dimensionless, >= 0
+  double restitution = 0.0;  // e, in [0, 1]
+};
+
+// Checks name against [A-Za-z_][A-Za-z0-9_]* and the reserved name 'ground'.
+physics::Status ValidateModelName(const std::string& name);
+
+// The body of a loaded URDF model placed as the spec asks. Friction: the
+// spec's if >= 0, else the URDF's (gazebo mu1) where given, else the default;
+// restitution: the spec's if >= 0, else the default. A static body (asked
+// for, or fixed to 'world' in the URDF) gets zero velocity. Fails on an
+// out-of-range friction or restitution, naming it.
+physics::Result<physics::BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
+                                              const MaterialDefaults& defaults);
+
+// Rigid-body velocity transfer between two frames of one body:
+// v_link = v_root + w x (p_link - p_root), w shared.
+FrameState LinkStateFromRoot(const FrameState& root, const physics::Pose& root_from_link);
+FrameState RootStateFromLink(const FrameState& link, const physics::Pose& root_from_link);
+
+// '<model>/<link>'.
+std::string FrameName(const std::string& model, const std::string& link);
+
+struct Model {
+  std::string name;
+  physics::BodyId body;
+  bool is_static = false;
+  std::vector<io::LinkFrame> links;      // every link of the body, root first
+  std::vector<std::string> shape_links;  // per shape of the body, the link it came from
+  FrameState spawn_state;                // of the root link, restored by a reset
+};
+
+// A frame of a model: the model and one of its links.
+struct FrameRef {
+  const Model* model = nullptr;
+  const io::LinkFrame* link = nullptr;
+};
+
+// Models by name, and by body for naming contacts. Not thread-safe: the node
+// guards it with the world's mutex.
+class ModelRegistry {
+ public:
+  // Refuses a name in use.
+  physics::Status Add(Model model);
+  // Returns false for an unknown name.
+  bool Remove(const std::string& name);
+  const Model* Find(const std::string& name) const;
+  const Model* FindByBody(physics::BodyId body) const;
+  // A model name (its root link) or '<model>/<link>'; fails naming the
+  // unknown model or link.
+  physics::Result<FrameRef> ResolveFrame(const std::string& frame) const;
+  // '<model>/<link>' of a shape of a body, or "" for a body that is no model.
+  std::string ShapeFrame(physics::BodyId body, int shape_index) const;
+
+  const std::map<std::string, Model>& models() const { return models_; }
+  std::size_t size() const { return models_.size(); }
+  void Clear();
+
+ private:
+  static std::uint64_t Key(physics::BodyId body) {
+    return (static_cast<std::uint64_t>(body.index) << 32) | body.generation;
+  }
+  std::map<std::string, Model> models_;  // ordered, so messages list models stably
+  std::unordered_map<std::uint64_t, std::string> name_by_body_;
+};
+
+}  // namespace rigid_body_sim::node
+
+#endif  // RIGID_BODY_SIM_NODE_MODEL_REGISTRY_H_

@@ -1,0 +1,92 @@
+// The one place where ROS message types meet the core's types. Conversions
+// from messages validate what they read (finite numbers, usable quaternions)
+// and fail with a message naming the field.
+#ifndef RIGID_BODY_SIM_NODE_MSG_CONVERSION_H_
+#define RIGID_BODY_SIM_NODE_MSG_CONVERSION_H_
+
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/Point.h>
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <geometry_msgs/Twist.h>
+#include <geometry_msgs/Vector3.h>
+#include <ros/time.h>
+#include <visualization_msgs/Marker.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "rigid_body_sim/Contact.h"
+#include "rigid_body_sim/Spawn.h"
+#include "rigid_body_sim/node/model_registry.h"
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/shape.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::node {
+
+// --- messages to core ---------------------------------------------------------
+
+// Fails on a non-finite component, naming `field`.
+physics::Result<physics::Vec3> VectorFromMsg(const geometry_msgs::Vector3& msg,
+                                             const std::string& field);
+physics::Result<physics::Vec3> PointFromMsg(const geometry_msgs::Point& msg,
+                                            const std::string& field);
+// Fails on a non-finite position or orientation, or a quaternion of norm
+// below 1e-9 (no rotation); any other quaternion is normalised.
+physics::Result<physics::Pose> PoseFromMsg(const geometry_msgs::Pose& msg,
+                                           const std::string& field);
+physics::Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
+                                              const geometry_msgs::Twist& twist);
+// The spawn request as a spec; checks only the pose and twist.
+physics::Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request);
+
+// --- core to messages ---------------------------------------------------------
+
+geometry_msgs::Vector3 VectorToMsg(const physics::Vec3& vector);
+geometry_msgs::Point PointToMsg(const physics::Vec3& point);
+geometry_msgs::Pose PoseToMsg(const physics::Pose& pose);
+geometry_msgs::Twist TwistToMsg(const physics::Vec3& linear_velocity,
+                                const physics::Vec3& angular_velocity);
+geometry_msgs::TransformStamped TransformToMsg(const physics::Pose& parent_from_child,
+                                               const std::string& parent_frame,
+                                               const std::string& child_frame,
+                                               const ros::Time& stamp);
+// Sim time (s) as a ROS time stamp.
+ros::Time SimTimeToRos(double sim_time);
+
+rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
+                                     const std::string& body_a, const std::string& body_b);
+
+// --- markers ----------------------------------------------------------------
+
+// The collision geometry of one body, locked to `frame` (the body frame):
+// a SPHERE per sphere, a TRIANGLE_LIST of the hull's faces per polyhedron
+// and a thin CUBE of `half_space_size` (m) per half-space, with ids 0, 1, ...
+// in namespace `ns`.
+std::vector<visualization_msgs::Marker> ShapeMarkers(const std::vector<physics::ShapeDef>& shapes,
+                                                     const std::string& ns,
+                                                     const std::string& frame,
+                                                     double half_space_size = 20.0);
+// DELETE markers for ids 0 .. count-1 in namespace `ns`.
+std::vector<visualization_msgs::Marker> DeleteMarkers(const std::string& ns, int count);
+
+struct ContactMarkerStyle {
+  std::string frame;  // the world frame
+  ros::Time stamp;
+  double force_scale = 0.02;  // m of arrow per N of normal force
+  double min_arrow = 0.05;    // m, shortest arrow, so force-free contacts stay visible
+  double point_size = 0.03;   // m, diameter of the point sphere
+};
+
+// Per contact i a point sphere (id 2i) and a normal arrow (id 2i+1) whose
+// length is normal_force * force_scale, coloured by type (colliding red,
+// resting green, separating blue). Ids from the previous array that are no
+// longer used (up to 2 * previous_count) are deleted.
+visualization_msgs::MarkerArray ContactMarkers(const std::vector<physics::ContactReport>& contacts,
+                                               int previous_count, const ContactMarkerStyle& style);
+
+}  // namespace rigid_body_sim::node
+
+#endif  // RIGID_BODY_SIM_NODE_MSG_CONVERSION_H_

@@ -1,0 +1,41 @@
+// Every topic, service and reserved name of the node. Names without a
+// leading slash live in the node's private namespace (~).
+#ifndef RIGID_BODY_SIM_NODE_NAMES_H_
+#define RIGID_BODY_SIM_NODE_NAMES_H_
+
+namespace rigid_body_sim::node::names {
+
+inline constexpr char kDefaultNodeName[] = "rigid_body_sim";
+
+// Services (~).
+inline constexpr char kSpawnService[] = "spawn";
+inline constexpr char kDeleteService[] = "delete";
+inline constexpr char kResetService[] = "reset";
+inline constexpr char kSetPausedService[] = "set_paused";
+inline constexpr char kStepService[] = "step";
+inline constexpr char kGetStateService[] = "get_state";
+inline constexpr char kSetStateService[] = "set_state";
+inline constexpr char kApplyWrenchService[] = "apply_wrench";
+inline constexpr char kGetPhysicsService[] = "get_physics";
+inline constexpr char kSetPhysicsService[] = "set_physics";
+
+// Topics (~).
+inline constexpr char kContactsTopic[] = "contacts";
+inline constexpr char kStatesTopic[] = "states";
+inline constexpr char kContactMarkersTopic[] = "contact_markers";
+inline constexpr char kBodyMarkersTopic[] = "body_markers";
+
+// Global topics.
+inline constexpr char kTfTopic[] = "/tf";
+inline constexpr char kTfStaticTopic[] = "/tf_static";
+inline constexpr char kClockTopic[] = "/clock";
+inline constexpr char kUseSimTimeParam[] = "/use_sim_time";
+
+// The infinite ground plane's name in contacts; no model may take it.
+inline constexpr char kGroundName[] = "ground";
+// Separates the model and the link in frame names: '<model>/<link>'.
+inline constexpr char kFrameSeparator = '/';
+
+}  // namespace rigid_body_sim::node::names
+
+#endif  // RIGID_BODY_SIM_NODE_NAMES_H_

@@ -1,0 +1,66 @@
+// Every parameter of the node, read once from the private namespace into one
+// struct and validated. Units and defaults are listed here and in
+// config/sim.yaml.
+#ifndef RIGID_BODY_SIM_NODE_OPTIONS_H_
+#define RIGID_BODY_SIM_NODE_OPTIONS_H_
+
+#include <string>
+#include <vector>
+
+#include <ros/node_handle.h>
+
+#include "rigid_body_sim/node/model_registry.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/world.h"
+
+namespace rigid_body_sim::node {
+
+struct NodeOptions {
+  std::string world_frame = "world";  // ~world_frame: parent of every body frame
+  // ~gravity [x, y, z] (m/s^2, default [0, 0, -9.81]), ~time_step (s, > 0,
+  // default 1/240), ~contact_margin (m, 0.005), ~continuous_fraction ((0, 1],
+  // 0.25), ~solver/{velocity_iterations (20), position_iterations (6),
+  // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-3),
+  // penetration_slop (m, 0.5e-3), position_correction (1/step, 0.2),
+  // max_collision_rounds (32), collision_iterations (30)} and
+  // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
+  // (rad/s, 0.1), time_to_sleep (s, 0.5)}; see physics/world.h.
+  physics::WorldSettings world;
+  double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
+  double publish_rate = 50.0;       // ~publish_rate: Hz of /tf, ~states, ~contacts, > 0
+  bool paused = false;              // ~paused: start without stepping
+  bool use_sim_time = false;        // /use_sim_time (global, default false): publish /clock
+  bool ground_plane = true;         // ~ground_plane: static plane z = 0 named 'ground'
+  double ground_friction = 0.8;     // ~ground_friction: Coulomb mu, >= 0
+  double ground_restitution = 0.0;  // ~ground_restitution: in [0, 1]
+  MaterialDefaults defaults;  // ~default_friction (0.5, >= 0), ~default_restitution (0.0, [0, 1])
+  // ~default_density (kg/m^3, 1000), ~max_hull_vertices (count, 256),
+  // ~cylinder_segments (count, 32) for URDF loading.
+  double default_density = 1000.0;
+  int max_hull_vertices = 256;
+  int cylinder_segments = 32;
+  double status_period = 5.0;  // ~status_period: s of real time between INFO status lines, > 0
+  // ~contact_force_scale: m of contact-marker arrow per N of normal force, > 0
+  double contact_force_scale = 0.02;
+  // ~models: spawned at start-up, in order; each entry has the fields of
+  // Spawn (name, urdf, urdf_path, is_static, friction, restitution), pose:
+  // [x, y, z, roll, pitch, yaw] (m, rad; default all 0) and twist:
+  // [vx, vy, vz, wx, wy, wz] (m/s, rad/s; default all 0).
+  std::vector<ModelSpec> models;
+};
+
+// Checks ranges and the model list (valid unique names, a URDF source each).
+physics::Status ValidateNodeOptions(const NodeOptions& options);
+
+// Reads every parameter from `private_node` (defaults for missing ones) and
+// validates the result. Fails, naming the parameter, on a wrong type or an
+// invalid value.
+physics::Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node);
+
+// Fixed-axis roll about x, then pitch about y, then yaw about z (URDF rpy,
+// REP 103): R = Rz(yaw) Ry(pitch) Rx(roll).
+physics::Quat QuatFromRollPitchYaw(double roll, double pitch, double yaw);
+
+}  // namespace rigid_body_sim::node
+
+#endif  // RIGID_BODY_SIM_NODE_OPTIONS_H_

@@ -1,0 +1,166 @@
+// The simulator node: owns the world and the model registry, steps the world
+// in its own thread, and serves and publishes everything in names.h.
+#ifndef RIGID_BODY_SIM_NODE_SIM_NODE_H_
+#define RIGID_BODY_SIM_NODE_SIM_NODE_H_
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <ros/ros.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "rigid_body_sim/ApplyWrench.h"
+#include "rigid_body_sim/Contacts.h"
+#include "rigid_body_sim/Delete.h"
+#include "rigid_body_sim/GetPhysics.h"
+#include "rigid_body_sim/GetState.h"
+#include "rigid_body_sim/ModelStates.h"
+#include "rigid_body_sim/SetPhysics.h"
+#include "rigid_body_sim/SetState.h"
+#include "rigid_body_sim/Spawn.h"
+#include "rigid_body_sim/Step.h"
+#include "rigid_body_sim/io/urdf_loader.h"
+#include "rigid_body_sim/node/model_registry.h"
+#include "rigid_body_sim/node/options.h"
+#include "rigid_body_sim/physics/world.h"
+
+namespace rigid_body_sim::node {
+
+// Thread model: ROS callbacks run on an AsyncSpinner's threads, the world
+// steps in the loop thread, and one mutex serialises every access to the
+// world, the registry and the node's state. A step holds the mutex, so a
+// spawn, delete or teleport happens between two steps, and every service
+// answers after its effect. URDF parsing and hull building happen before the
+// mutex is taken. Messages are built under the mutex and published after.
+class SimNode {
+ public:
+  SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle private_node);
+  ~SimNode();
+  SimNode(const SimNode&) = delete;
+  SimNode& operator=(const SimNode&) = delete;
+
+  // Adds the ground plane, spawns ~models, advertises the topics and
+  // services and starts stepping. Fails naming the first model that could
+  // not be spawned.
+  physics::Status Start();
+
+ private:
+  // A force and torque applied for a number of steps.
+  struct ActiveWrench {
+    physics::BodyId body;
+    physics::Vec3 force_world;   // N
+    physics::Vec3 point_world;   // m
+    physics::Vec3 torque_world;  // N m
+    std::int64_t remaining_steps = 0;
+  };
+  // Messages built under the mutex, published after it is released.
+  struct Outbox {
+    std::optional<tf2_msgs::TFMessage> tf;
+    std::optional<tf2_msgs::TFMessage> tf_static;
+    std::optional<rigid_body_sim::ModelStates> states;
+    std::optional<rigid_body_sim::Contacts> contacts;
+    std::optional<visualization_msgs::MarkerArray> contact_markers;
+    std::optional<visualization_msgs::MarkerArray> body_markers;
+    std::optional<double> clock;    // s of sim time
+    bool tf_is_new_frame = false;   // tf holds only the frames of a new model
+    std::uint64_t reset_count = 0;  // resets before the messages were built
+  };
+  using Clock = std::chrono::steady_clock;
+
+  // Locks the world mutex, telling the step loop to let the caller in first.
+  std::unique_lock<std::mutex> LockWorld();
+
+  physics::Result<std::vector<std::string>> SpawnModel(const ModelSpec& spec);
+  physics::Result<io::LoadedModel> LoadModel(const ModelSpec& spec) const;
+
+  bool OnSpawn(rigid_body_sim::Spawn::Request& request, rigid_body_sim::Spawn::Response& response);
+  bool OnDelete(rigid_body_sim::Delete::Request& request,
+                rigid_body_sim::Delete::Response& response);
+  bool OnReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool OnSetPaused(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
+  bool OnStep(rigid_body_sim::Step::Request& request, rigid_body_sim::Step::Response& response);
+  bool OnGetState(rigid_body_sim::GetState::Request& request,
+                  rigid_body_sim::GetState::Response& response);
+  bool OnSetState(rigid_body_sim::SetState::Request& request,
+                  rigid_body_sim::SetState::Response& response);
+  bool OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
+                     rigid_body_sim::ApplyWrench::Response& response);
+  bool OnGetPhysics(rigid_body_sim::GetPhysics::Request& request,
+                    rigid_body_sim::GetPhysics::Response& response);
+  bool OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
+                    rigid_body_sim::SetPhysics::Response& response);
+  void OnBodyMarkersSubscriber(const ros::SingleSubscriberPublisher& publisher);
+
+  void StepLoop();
+  // The callers of these hold the mutex.
+  void StepLocked();
+  void ReanchorLocked();
+  FrameState RootStateLocked(const Model& model) const;
+  // The periodic messages; tf, contacts and the clock only when sim time
+  // moved since they were last built.
+  void FillPeriodicLocked(Outbox* outbox);
+  tf2_msgs::TFMessage ModelTfLocked(const Model& model) const;
+  tf2_msgs::TFMessage StaticTfLocked() const;
+  void LogStatusLocked(Clock::time_point now);
+
+  void Publish(Outbox outbox);
+
+  const NodeOptions options_;
+  io::UrdfLoadOptions load_options_;
+  ros::NodeHandle node_;
+  ros::NodeHandle private_node_;
+  ros::Publisher tf_publisher_;
+  ros::Publisher tf_static_publisher_;
+  ros::Publisher clock_publisher_;
+  ros::Publisher states_publisher_;
+  ros::Publisher contacts_publisher_;
+  ros::Publisher contact_markers_publisher_;
+  ros::Publisher body_markers_publisher_;
+  std::vector<ros::ServiceServer> services_;
+
+  std::mutex mutex_;
+  std::condition_variable wake_;  // pause, resume, settings, shutdown
+  std::atomic<int> waiting_{0};   // callers blocked in LockWorld
+  physics::World world_;
+  ModelRegistry registry_;
+  std::optional<physics::BodyId> ground_;
+  std::vector<ActiveWrench> wrenches_;
+  std::map<std::string, std::vector<visualization_msgs::Marker>> body_markers_;  // by model
+  bool paused_ = false;
+  bool shutdown_ = false;
+  double real_time_factor_ = 1.0;
+  double last_periodic_time_ = -1.0;  // sim time of the last tf and contacts
+  int contact_marker_count_ = 0;      // contacts drawn in the last contact markers
+  std::uint64_t steps_ = 0;
+  // Pacing: sim time anchor_sim_ is due at wall time anchor_wall_.
+  Clock::time_point anchor_wall_;
+  double anchor_sim_ = 0.0;
+  Clock::time_point status_wall_;
+  double status_sim_ = 0.0;
+
+  std::mutex clock_mutex_;  // keeps /clock monotonic between resets
+  double last_clock_ = 0.0;
+  std::uint64_t reset_count_ = 0;  // guarded by mutex_
+  // Keeps /tf stamps monotonic between resets, and drops messages built
+  // before a reset.
+  std::mutex publish_mutex_;
+  std::uint64_t tf_reset_count_ = 0;
+  ros::Time last_tf_stamp_;
+
+  std::thread loop_thread_;
+};
+
+}  // namespace rigid_body_sim::node
+
+#endif  // RIGID_BODY_SIM_NODE_SIM_NODE_H_

@@ -1,0 +1,261 @@
+#include "rigid_body_sim/node/msg_conversion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <variant>
+
+namespace rigid_body_sim::node {
+
+using physics::Pose;
+using physics::Quat;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+namespace {
+
+constexpr double kMinQuaternionNorm = 1e-9;
+
+std_msgs::ColorRGBA Color(float r, float g, float b, float a) {
+  std_msgs::ColorRGBA color;
+  color.r = r;
+  color.g = g;
+  color.b = b;
+  color.a = a;
+  return color;
+}
+
+visualization_msgs::Marker BaseMarker(const std::string& ns, int id, const std::string& frame) {
+  visualization_msgs::Marker marker;
+  marker.header.frame_id = frame;
+  marker.ns = ns;
+  marker.id = id;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.orientation.w = 1.0;
+  return marker;
+}
+
+}  // namespace
+
+Result<Vec3> VectorFromMsg(const geometry_msgs::Vector3& msg, const std::string& field) {
+  const Vec3 vector(msg.x, msg.y, msg.z);
+  if (!vector.allFinite()) return Result<Vec3>::Error(field + " is not finite");
+  return vector;
+}
+
+Result<Vec3> PointFromMsg(const geometry_msgs::Point& msg, const std::string& field) {
+  const Vec3 point(msg.x, msg.y, msg.z);
+  if (!point.allFinite()) return Result<Vec3>::Error(field + " is not finite");
+  return point;
+}
+
+Result<Pose> PoseFromMsg(const geometry_msgs::Pose& msg, const std::string& field) {
+  Result<Vec3> position = PointFromMsg(msg.position, field + ".position");
+  if (!position.ok()) return position.status();
+  Quat rotation(msg.orientation.w, msg.orientation.x, msg.orientation.y, msg.orientation.z);
+  if (!rotation.coeffs().allFinite()) {
+    return Result<Pose>::Error(field + ".orientation is not finite");
+  }
+  if (rotation.norm() < kMinQuaternionNorm) {
+    return Result<Pose>::Error(field + ".orientation is a zero quaternion");
+  }
+  rotation.normalize();
+  return Pose{*position, rotation};
+}
+
+Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
+                                     const geometry_msgs::Twist& twist) {
+  Result<Pose> world_from_frame = PoseFromMsg(pose, "pose");
+  if (!world_from_frame.ok()) return world_from_frame.status();
+  Result<Vec3> linear = VectorFromMsg(twist.linear, "twist.linear");
+  if (!linear.ok()) return linear.status();
+  Result<Vec3> angular = VectorFromMsg(twist.angular, "twist.angular");
+  if (!angular.ok()) return angular.status();
+  return FrameState{*world_from_frame, *linear, *angular};
+}
+
+Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request) {
+  Result<FrameState> state = FrameStateFromMsg(request.pose, request.twist);
+  if (!state.ok()) return state.status();
+  ModelSpec spec;
+  spec.name = request.name;
+  spec.urdf = request.urdf;
+  spec.urdf_path = request.urdf_path;
+  spec.root_state = *state;
+  spec.is_static = request.is_static;
+  spec.friction = request.friction;
+  spec.restitution = request.restitution;
+  return spec;
+}
+
+geometry_msgs::Vector3 VectorToMsg(const Vec3& vector) {
+  geometry_msgs::Vector3 msg;
+  msg.x = vector.x();
+  msg.y = vector.y();
+  msg.z = vector.z();
+  return msg;
+}
+
+geometry_msgs::Point PointToMsg(const Vec3& point) {
+  geometry_msgs::Point msg;
+  msg.x = point.x();
+  msg.y = point.y();
+  msg.z = point.z();
+  return msg;
+}
+
+geometry_msgs::Pose PoseToMsg(const Pose& pose) {
+  geometry_msgs::Pose msg;
+  msg.position = PointToMsg(pose.translation);
+  msg.orientation.w = pose.rotation.w();
+  msg.orientation.x = pose.rotation.x();
+  msg.orientation.y = pose.rotation.y();
+  msg.orientation.z = pose.rotation.z();
+  return msg;
+}
+
+geometry_msgs::Twist TwistToMsg(const Vec3& linear_velocity, const Vec3& angular_velocity) {
+  geometry_msgs::Twist msg;
+  msg.linear = VectorToMsg(linear_velocity);
+  msg.angular = VectorToMsg(angular_velocity);
+  return msg;
+}
+
+geometry_msgs::TransformStamped TransformToMsg(const Pose& parent_from_child,
+                                               const std::string& parent_frame,
+                                               const std::string& child_frame,
+                                               const ros::Time& stamp) {
+  geometry_msgs::TransformStamped msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = parent_frame;
+  msg.child_frame_id = child_frame;
+  msg.transform.translation = VectorToMsg(parent_from_child.translation);
+  msg.transform.rotation = PoseToMsg(parent_from_child).orientation;
+  return msg;
+}
+
+ros::Time SimTimeToRos(double sim_time) { return ros::Time(std::max(sim_time, 0.0)); }
+
+rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
+                                     const std::string& body_a, const std::string& body_b) {
+  rigid_body_sim::Contact msg;
+  msg.body_a = body_a;
+  msg.body_b = body_b;
+  msg.position = PointToMsg(contact.position_world);
+  msg.normal = VectorToMsg(contact.normal_world);
+  msg.depth = contact.depth;
+  msg.normal_velocity = contact.normal_velocity;
+  msg.type = static_cast<std::uint8_t>(contact.type);
+  msg.normal_impulse = contact.normal_impulse;
+  msg.friction_impulse = VectorToMsg(contact.friction_impulse_world);
+  msg.normal_force = contact.normal_force;
+  return msg;
+}
+
+std::vector<visualization_msgs::Marker> ShapeMarkers(const std::vector<physics::ShapeDef>& shapes,
+                                                     const std::string& ns,
+                                                     const std::string& frame,
+                                                     double half_space_size) {
+  std::vector<visualization_msgs::Marker> markers;
+  markers.reserve(shapes.size());
+  for (std::size_t i = 0; i < shapes.size(); ++i) {
+    const physics::ShapeDef& shape = shapes[i];
+    visualization_msgs::Marker marker = BaseMarker(ns, static_cast<int>(i), frame);
+    marker.frame_locked = true;
+    marker.pose = PoseToMsg(shape.body_from_shape);
+    marker.color = Color(0.6f, 0.65f, 0.7f, 0.9f);
+    if (const auto* sphere = std::get_if<physics::Sphere>(&shape.geometry)) {
+      marker.type = visualization_msgs::Marker::SPHERE;
+      marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * sphere->radius;
+    } else if (const auto* hull =
+                   std::get_if<std::shared_ptr<const physics::ConvexPolyhedron>>(&shape.geometry)) {
+      marker.type = visualization_msgs::Marker::TRIANGLE_LIST;
+      marker.scale.x = marker.scale.y = marker.scale.z = 1.0;
+      const physics::TriangleMesh mesh = (*hull)->Triangulate();
+      marker.points.reserve(3 * mesh.triangles.size());
+      for (const Eigen::Vector3i& triangle : mesh.triangles) {
+        for (int corner = 0; corner < 3; ++corner) {
+          marker.points.push_back(PointToMsg(mesh.vertices[triangle[corner]]));
+        }
+      }
+    } else {
+      // The half-space z <= 0 of the shape frame, drawn as a thin slab just
+      // below its surface.
+      constexpr double kSlabThickness = 0.01;  // m
+      marker.type = visualization_msgs::Marker::CUBE;
+      marker.scale.x = marker.scale.y = half_space_size;
+      marker.scale.z = kSlabThickness;
+      marker.pose = PoseToMsg(shape.body_from_shape *
+                              Pose{Vec3(0.0, 0.0, -0.5 * kSlabThickness), Quat::Identity()});
+      marker.color = Color(0.35f, 0.35f, 0.35f, 1.0f);
+    }
+    markers.push_back(std::move(marker));
+  }
+  return markers;
+}
+
+std::vector<visualization_msgs::Marker> DeleteMarkers(const std::string& ns, int count) {
+  std::vector<visualization_msgs::Marker> markers;
+  for (int id = 0; id < count; ++id) {
+    visualization_msgs::Marker marker;
+    marker.ns = ns;
+    marker.id = id;
+    marker.action = visualization_msgs::Marker::DELETE;
+    markers.push_back(std::move(marker));
+  }
+  return markers;
+}
+
+visualization_msgs::MarkerArray ContactMarkers(const std::vector<physics::ContactReport>& contacts,
+                                               int previous_count,
+                                               const ContactMarkerStyle& style) {
+  static const std::string kNamespace = "contacts";
+  visualization_msgs::MarkerArray array;
+  array.markers.reserve(2 * std::max<std::size_t>(contacts.size(), previous_count));
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const physics::ContactReport& contact = contacts[i];
+    std_msgs::ColorRGBA color;
+    switch (contact.type) {
+      case physics::ContactType::kColliding:
+        color = Color(0.9f, 0.1f, 0.1f, 1.0f);
+        break;
+      case physics::ContactType::kResting:
+        color = Color(0.1f, 0.8f, 0.1f, 1.0f);
+        break;
+      case physics::ContactType::kSeparating:
+        color = Color(0.2f, 0.3f, 0.9f, 1.0f);
+        break;
+    }
+    visualization_msgs::Marker point = BaseMarker(kNamespace, static_cast<int>(2 * i), style.frame);
+    point.header.stamp = style.stamp;
+    point.type = visualization_msgs::Marker::SPHERE;
+    point.pose.position = PointToMsg(contact.position_world);
+    point.scale.x = point.scale.y = point.scale.z = style.point_size;
+    point.color = color;
+    array.markers.push_back(std::move(point));
+
+    visualization_msgs::Marker arrow =
+        BaseMarker(kNamespace, static_cast<int>(2 * i + 1), style.frame);
+    arrow.header.stamp = style.stamp;
+    arrow.type = visualization_msgs::Marker::ARROW;
+    const double length =
+        std::max(style.min_arrow, std::abs(contact.normal_force) * style.force_scale);
+    arrow.points = {PointToMsg(contact.position_world),
+                    PointToMsg(contact.position_world + length * contact.normal_world)};
+    arrow.scale.x = 0.3 * style.point_size;  // shaft diameter
+    arrow.scale.y = 0.6 * style.point_size;  // head diameter
+    arrow.scale.z = 0.0;                     // default head length
+    arrow.color = color;
+    array.markers.push_back(std::move(arrow));
+  }
+  for (int id = static_cast<int>(2 * contacts.size()); id < 2 * previous_count; ++id) {
+    visualization_msgs::Marker marker = BaseMarker(kNamespace, id, style.frame);
+    marker.header.stamp = style.stamp;
+    marker.action = visualization_msgs::Marker::DELETE;
+    array.markers.push_back(std::move(marker));
+  }
+  return array;
+}
+
+}  // namespace rigid_body_sim::node

@@ -1,0 +1,56 @@
+// Validation of the node's parameters; no ROS master needed.
+#include "rigid_body_sim/node/options.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace rigid_body_sim::node {
+namespace {
+
+using physics::Vec3;
+
+TEST(OptionsTest, DefaultsAreValid) { EXPECT_TRUE(ValidateNodeOptions(NodeOptions()).ok()); }
+
+TEST(OptionsTest, BadValuesAreNamed) {
+  NodeOptions options;
+  options.world.time_step = -0.01;
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~time_step -0.01 s must be positive and finite");
+  options = NodeOptions();
+  options.real_time_factor = -1.0;
+  EXPECT_NE(ValidateNodeOptions(options).message().find("~real_time_factor"), std::string::npos);
+  options = NodeOptions();
+  options.ground_restitution = 1.5;
+  EXPECT_EQ(ValidateNodeOptions(options).message(), "~ground_restitution 1.5 must be in [0, 1]");
+  options = NodeOptions();
+  options.world_frame = "/world";
+  EXPECT_NE(ValidateNodeOptions(options).message().find("leading slash"), std::string::npos);
+}
+
+TEST(OptionsTest, ModelListNeedsUniqueNamesAndASource) {
+  NodeOptions options;
+  ModelSpec spec;
+  spec.name = "box";
+  spec.urdf_path = "box.urdf";
+  options.models = {spec, spec};
+  EXPECT_EQ(ValidateNodeOptions(options).message(), "~models: the name 'box' is used twice");
+  options.models = {spec};
+  options.models[0].urdf_path.clear();
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~models: 'box' has neither urdf nor urdf_path");
+}
+
+TEST(OptionsTest, RollPitchYawIsFixedAxisXThenYThenZ) {
+  // A quarter yaw takes x to y; a quarter pitch takes x to -z; applied after
+  // the pitch, the yaw leaves -z alone: R = Rz Ry Rx.
+  EXPECT_TRUE((QuatFromRollPitchYaw(0, 0, M_PI / 2) * Vec3::UnitX()).isApprox(Vec3::UnitY()));
+  EXPECT_TRUE((QuatFromRollPitchYaw(0, M_PI / 2, 0) * Vec3::UnitX()).isApprox(-Vec3::UnitZ()));
+  EXPECT_TRUE(
+      (QuatFromRollPitchYaw(0, M_PI / 2, M_PI / 2) * Vec3::UnitX()).isApprox(-Vec3::UnitZ()));
+  EXPECT_TRUE(
+      (QuatFromRollPitchYaw(M_PI / 2, 0, M_PI / 2) * Vec3::UnitY()).isApprox(Vec3::UnitZ()));
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::node
