@@ -30,7 +30,7 @@ demo: build
 
 test: build
 	@echo "[test] building the tests"
-	$(CATKIN) tests -j$(JOBS) 2>&1 | (grep --line-buffered -E '^\[ *[0-9]+%\]|error|warning' || true)
+	$(CATKIN) tests -j$(JOBS) 2>&1 | (grep --line-buffered -E '^\[ *[0-9]+%\]|[Ee]rror|warning|undefined' || true)
 	@echo "[test] running every test"
 	cd $(WS)/build && ctest --output-on-failure
 
@@ -57,7 +57,8 @@ test-sanitize: deps
 
 # The concurrency rostest with the node and its client built under
 # ThreadSanitizer in a second workspace; any report fails the target.
-WS_TSAN := $(ROOT)/.ws-tsan
+# Under build/, which rosrun does not search, so spawn_model stays unambiguous.
+WS_TSAN := $(ROOT)/build/ws-tsan
 test-tsan: deps
 	mkdir -p $(WS_TSAN)/src
 	ln -sfn $(ROOT) $(WS_TSAN)/src/rigid_body_sim
@@ -65,7 +66,7 @@ test-tsan: deps
 	  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
 	  -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread $(CMAKE_ARGS) \
 	  rigid_body_sim_node node_concurrency_test -j$(JOBS) 2>&1 \
-	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|error|warning' || true)
+	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|[Ee]rror|warning|undefined' || true)
 	rm -f $(WS_TSAN)/tsan.*
 	source $(WS_TSAN)/devel/setup.bash && \
 	  TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(ROOT)/test/node/tsan.supp log_path=$(WS_TSAN)/tsan" \
@@ -73,6 +74,30 @@ test-tsan: deps
 	@if ls $(WS_TSAN)/tsan.* > /dev/null 2>&1; then \
 	  cat $(WS_TSAN)/tsan.*; echo "[test-tsan] ThreadSanitizer reported a race" >&2; exit 1; fi
 	@echo "[test-tsan] no ThreadSanitizer reports"
+
+# The benchmark scenes in our engine and side by side in Bullet (only this
+# build links Bullet), then the component benchmarks and the plot. A plain
+# CMake Release build of the ROS-free core. pile_4000 and pyramid_90
+# simulate BENCH_SCALE x 10 s so that the run stays within minutes.
+BENCH_BUILD := $(ROOT)/build/bench
+BENCH_SCALE ?= 0.25
+BENCH_RUNS ?= 3
+bench: deps
+	cmake -S $(ROOT) -B $(BENCH_BUILD) -DRBS_CORE_ONLY=ON -DRBS_BENCH=ON -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" > /dev/null
+	cmake --build $(BENCH_BUILD) -j$(JOBS) \
+	  --target physics_bench hull_bench narrow_phase_bench broad_phase_bench
+	mkdir -p $(ROOT)/bench/results
+	@echo "[bench] $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $$(date -u '+%F %H:%M UTC')"
+	$(BENCH_BUILD)/physics_bench --runs $(BENCH_RUNS) --scale $(BENCH_SCALE) \
+	  --csv $(ROOT)/bench/results/latest.csv --hull-bench $(BENCH_BUILD)/hull_bench
+	@if [ -x $(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node ]; then \
+	  source $(WS)/devel/setup.bash && \
+	  python3 $(ROOT)/bench/spawn_bench.py --csv $(ROOT)/bench/results/latest.csv; \
+	else echo "spawn: node not built ($(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node; make build)"; fi
+	$(BENCH_BUILD)/narrow_phase_bench 200000
+	$(BENCH_BUILD)/broad_phase_bench 30
+	python3 $(ROOT)/bench/plot.py $(ROOT)/bench/results/latest.csv $(ROOT)/bench/results/ms_per_step.png
 
 clean:
 	rm -rf $(WS) $(WS_TSAN) $(ROOT)/build
