@@ -46,10 +46,13 @@ build: deps $(WS)/src/rigid_body_sim
 	$(CATKIN) -j$(JOBS) 2>&1 | (grep --line-buffered -vE '^-- (Found|Looking|Detecting|Check|Performing|Using)' || true)
 
 # The ROS-free libraries and their gtests under AddressSanitizer and
-# UndefinedBehaviorSanitizer, built with plain CMake.
+# UndefinedBehaviorSanitizer, built with plain CMake. GCC 12's
+# maybe-uninitialized analysis gives false positives on instrumented code
+# (std::variant holding a shared_ptr), so that one warning is off here; the
+# -Werror build is `make test`'s.
 test-sanitize: deps
 	cmake -S $(ROOT) -B $(CORE_BUILD) -DRBS_CORE_ONLY=ON -DRBS_WERROR=ON -DCMAKE_BUILD_TYPE=Debug \
-	  -DCMAKE_CXX_FLAGS="-O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+	  -DCMAKE_CXX_FLAGS="-O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -Wno-maybe-uninitialized" \
 	  > /dev/null
 	cmake --build $(CORE_BUILD) -j$(JOBS)
 	cd $(CORE_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
@@ -80,7 +83,7 @@ test-tsan: deps
 # CMake Release build of the ROS-free core. pile_4000 and pyramid_90
 # simulate BENCH_SCALE x 10 s so that the run stays within minutes.
 BENCH_BUILD := $(ROOT)/build/bench
-BENCH_SCALE ?= 0.25
+BENCH_SCALE ?= 0.2
 BENCH_RUNS ?= 3
 bench: deps
 	cmake -S $(ROOT) -B $(BENCH_BUILD) -DRBS_CORE_ONLY=ON -DRBS_BENCH=ON -DCMAKE_BUILD_TYPE=Release \

@@ -1,0 +1,51 @@
+// The interface through which the benchmark drives each physics engine.
+#ifndef RIGID_BODY_SIM_BENCH_ENGINE_H_
+#define RIGID_BODY_SIM_BENCH_ENGINE_H_
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include "scene.h"
+
+namespace rigid_body_sim::bench {
+
+// Wall time of one step split by stage. Engines whose stages differ map
+// theirs onto these (bullet_engine.cc says how).
+struct StageTimes {
+  double broad_phase_ms = 0.0;
+  double narrow_phase_ms = 0.0;  // ours: narrow phase plus contact cache
+  double solver_ms = 0.0;
+  double integrator_ms = 0.0;     // ours and Bullet's: integration and sleeping
+  std::size_t solver_points = 0;  // contact points the solver saw
+};
+
+class Engine {
+ public:
+  virtual ~Engine() = default;
+  virtual std::string name() const = 0;
+  // Advances by the engine's one step of 1/240 s.
+  virtual void Step() = 0;
+  // Stage times of the last Step.
+  virtual StageTimes LastStageTimes() const = 0;
+  // Position (m, world) and linear velocity (m/s) of scene body `index`.
+  virtual Vec3 Position(int index) const = 0;
+  virtual Vec3 LinearVelocity(int index) const = 0;
+  // J, summed over the dynamic bodies.
+  virtual double KineticEnergy() const = 0;
+  // m, the deepest penetration among the current contact points.
+  virtual double MaxPenetration() const = 0;
+  // Contact rows one contact point adds to a velocity iteration, and the
+  // velocity iterations per step: the denominator of the cost per row.
+  virtual int RowsPerPoint() const = 0;
+  virtual int VelocityIterations() const = 0;
+};
+
+constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines
+
+std::unique_ptr<Engine> MakeOurEngine(const Scene& scene);
+std::unique_ptr<Engine> MakeBulletEngine(const Scene& scene);
+
+}  // namespace rigid_body_sim::bench
+
+#endif  // RIGID_BODY_SIM_BENCH_ENGINE_H_

@@ -1,0 +1,120 @@
+// The scenes in rigid_body_sim::physics::World with its default settings.
+#include <algorithm>
+#include <cassert>
+#include <memory>
+#include <vector>
+
+#include "engine.h"
+#include "rigid_body_sim/physics/convex_polyhedron.h"
+#include "rigid_body_sim/physics/mass_properties.h"
+#include "rigid_body_sim/physics/world.h"
+
+namespace rigid_body_sim::bench {
+namespace {
+
+namespace physics = rigid_body_sim::physics;
+
+physics::Material ToMaterial(const BenchMaterial& material) {
+  physics::Material result;
+  result.friction = material.friction;
+  result.restitution = material.restitution;
+  return result;
+}
+
+class OurEngine : public Engine {
+ public:
+  explicit OurEngine(const Scene& scene) {
+    physics::WorldSettings settings;
+    settings.time_step = kTimeStep;
+    world_ = std::make_unique<physics::World>(settings);
+
+    physics::BodyDef ground;
+    ground.is_static = true;
+    ground.world_from_body = scene.world_from_ground;
+    physics::ShapeDef half_space;
+    half_space.geometry = physics::HalfSpace{};
+    half_space.material = ToMaterial(scene.ground_material);
+    ground.shapes.push_back(half_space);
+    world_->CreateBody(ground).value();
+
+    // Boxes of one size share one polyhedron, as a user's meshes would.
+    std::vector<std::pair<Vec3, std::shared_ptr<const physics::ConvexPolyhedron>>> polyhedra;
+    for (const BenchBody& body : scene.bodies) {
+      physics::BodyDef def;
+      def.world_from_body = body.world_from_body;
+      physics::ShapeDef shape;
+      shape.material = ToMaterial(body.material);
+      if (body.shape == BenchBody::Shape::kBox) {
+        auto found = std::find_if(polyhedra.begin(), polyhedra.end(),
+                                  [&](const auto& entry) { return entry.first == body.box_size; });
+        if (found == polyhedra.end()) {
+          polyhedra.emplace_back(body.box_size, std::make_shared<const physics::ConvexPolyhedron>(
+                                                    physics::MakeBoxPolyhedron(body.box_size)));
+          found = polyhedra.end() - 1;
+        }
+        shape.geometry = found->second;
+        def.mass_properties =
+            physics::BoxMassProperties(body.mass / body.box_size.prod(), body.box_size);
+      } else {
+        const double r = body.sphere_radius;
+        shape.geometry = physics::Sphere{r};
+        def.mass_properties =
+            physics::SphereMassProperties(body.mass / (4.0 / 3.0 * M_PI * r * r * r), r);
+      }
+      def.shapes.push_back(shape);
+      ids_.push_back(world_->CreateBody(def).value());
+    }
+  }
+
+  std::string name() const override { return "ours"; }
+  void Step() override { world_->Step(); }
+
+  StageTimes LastStageTimes() const override {
+    const physics::StepProfile& profile = world_->last_step_profile();
+    StageTimes times;
+    times.broad_phase_ms = profile.broad_phase_ms;
+    times.narrow_phase_ms = profile.narrow_phase_ms + profile.contact_cache_ms;
+    times.solver_ms = profile.solver_ms;
+    times.integrator_ms = profile.integrator_ms;
+    times.solver_points = profile.solver_points;
+    return times;
+  }
+
+  Vec3 Position(int index) const override { return world_->GetPose(ids_[index]).translation; }
+  Vec3 LinearVelocity(int index) const override { return world_->GetLinearVelocity(ids_[index]); }
+
+  // T = 1/2 v.P + 1/2 omega.L per body.
+  double KineticEnergy() const override {
+    double energy = 0.0;
+    for (const physics::BodyId id : ids_) {
+      const physics::Body& body = world_->GetBody(id);
+      energy += 0.5 * body.linear_velocity.dot(body.linear_momentum) +
+                0.5 * body.angular_velocity.dot(body.angular_momentum);
+    }
+    return energy;
+  }
+
+  double MaxPenetration() const override {
+    double depth = 0.0;
+    for (const physics::ContactReport& contact : world_->contacts()) {
+      depth = std::max(depth, contact.depth);
+    }
+    return depth;
+  }
+
+  // A normal row and a two-dimensional friction row (the Coulomb disc).
+  int RowsPerPoint() const override { return 3; }
+  int VelocityIterations() const override { return world_->settings().solver.velocity_iterations; }
+
+ private:
+  std::unique_ptr<physics::World> world_;
+  std::vector<physics::BodyId> ids_;
+};
+
+}  // namespace
+
+std::unique_ptr<Engine> MakeOurEngine(const Scene& scene) {
+  return std::make_unique<OurEngine>(scene);
+}
+
+}  // namespace rigid_body_sim::bench

@@ -1,0 +1,71 @@
+// Benchmark scenes, described once and built by every engine under test.
+#ifndef RIGID_BODY_SIM_BENCH_SCENE_H_
+#define RIGID_BODY_SIM_BENCH_SCENE_H_
+
+#include <string>
+#include <vector>
+
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::bench {
+
+using physics::Pose;
+using physics::Quat;
+using physics::Vec3;
+
+// Material as our engine combines it: e = max(e_a, e_b),
+// mu = sqrt(mu_a mu_b). Engines with other rules convert (bullet_engine.cc).
+struct BenchMaterial {
+  double friction = 0.5;     // Coulomb coefficient, dimensionless
+  double restitution = 0.0;  // coefficient of restitution, [0, 1]
+};
+
+struct BenchBody {
+  enum class Shape { kBox, kSphere };
+  Shape shape = Shape::kBox;
+  Vec3 box_size = Vec3::Ones();  // m, full edge lengths (boxes)
+  double sphere_radius = 0.0;    // m (spheres)
+  double mass = 1.0;             // kg, uniform density
+  Pose world_from_body;          // m; the body frame is the shape's centre
+  BenchMaterial material;
+};
+
+// What the scene measures besides the time per step.
+enum class SceneKind {
+  kPile,     // drift of the top box: horizontal distance from its start column
+  kPyramid,  // drift of the top box: distance from its start (it should not move)
+  kBounce,   // first apex of the sphere against e^2 h
+  kIncline,  // distance slid along the slope against 1/2 g (sin - mu cos) t^2
+};
+
+struct Scene {
+  std::string name;
+  SceneKind kind = SceneKind::kPile;
+  // The ground: the half-space below the plane through the origin of
+  // world_from_ground with normal +z of that frame.
+  Pose world_from_ground;
+  BenchMaterial ground_material;
+  std::vector<BenchBody> bodies;
+  double seconds = 10.0;       // s of simulated time
+  int top_body = -1;           // index of the body whose drift is reported
+  double drop_height = 0.0;    // m, bounce: fall of the sphere's lowest point
+  double slope_degrees = 0.0;  // incline: slope angle
+};
+
+// pile_N: unit boxes (1 m, 1 kg, mu 0.5, e 0) in a square grid of
+// ceil(cbrt(N)) x ceil(cbrt(N)) columns 1.1 m apart, layers 1.2 m apart from
+// z = 0.6, each layer yawed a further 0.1 rad, back to 0 after 0.4 rad
+// (scene.cc: beyond 0.43 rad neighbours would start inside each other).
+Scene MakePile(int count, double seconds);
+// pyramid_R: R rows of unit boxes (mu 0.6) touching side by side, row r
+// holding R - r boxes; R (R + 1) / 2 boxes in all.
+Scene MakePyramid(int rows, double seconds);
+// bounce: a sphere of r 0.1 m, 1 kg, e 0.5, its lowest point 1 m above the
+// ground, released at rest.
+Scene MakeBounce();
+// incline: a unit box (1 kg, mu 0.5) at rest on a slope of `degrees`, for 2 s.
+Scene MakeIncline(double degrees);
+
+}  // namespace rigid_body_sim::bench
+
+#endif  // RIGID_BODY_SIM_BENCH_SCENE_H_

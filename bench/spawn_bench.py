@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Latency of one Spawn call through the running node, for a box URDF and a mesh URDF.
+
+  bench/spawn_bench.py [--calls N] [--csv bench/results/latest.csv]
+
+Needs the catkin workspace sourced (the rigid_body_sim service types and
+package:// paths). Starts its own master on a free port and the node with
+sim.launch, spawns N models of each URDF (each call timed from request to
+response in this client), appends the rows to the CSV and stops everything
+it started.
+"""
+import argparse
+import os
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import time
+
+URDF_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'urdf')
+MODELS = (('spawn_box', 'box.urdf'), ('spawn_mesh', 'mesh_object.urdf'))
+
+
+def free_port():
+    with socket.socket() as probe:
+        probe.bind(('localhost', 0))
+        return probe.getsockname()[1]
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument('--calls', type=int, default=20)
+    parser.add_argument('--csv', default='')
+    args = parser.parse_args()
+
+    port = free_port()
+    os.environ['ROS_MASTER_URI'] = f'http://localhost:{port}'
+    launch = subprocess.Popen(
+        ['roslaunch', '-p', str(port), 'rigid_body_sim', 'sim.launch', 'use_sim_time:=false'],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        import rospy
+        from geometry_msgs.msg import Pose, Twist
+        from rigid_body_sim.srv import Spawn, SpawnRequest
+
+        deadline = time.time() + 60.0
+        while True:
+            try:
+                rospy.init_node('spawn_bench', anonymous=True, disable_signals=True)
+                break
+            except Exception:  # the master is not up yet
+                if time.time() > deadline:
+                    raise
+                time.sleep(0.5)
+        rospy.wait_for_service('/rigid_body_sim/spawn', timeout=60.0)
+        spawn = rospy.ServiceProxy('/rigid_body_sim/spawn', Spawn, persistent=True)
+        rows = []
+        print('spawn latency through the node (client-side wall time of one call), '
+              f'{args.calls} calls per model')
+        print(f'{"scene":<11} {"urdf":<17} {"first ms":>9} {"median ms":>10} {"min ms":>8} '
+              f'{"max ms":>8}')
+        for index, (scene, urdf) in enumerate(MODELS):
+            times = []
+            for call in range(args.calls):
+                request = SpawnRequest()
+                request.name = f'{scene}_{call}'
+                request.urdf_path = os.path.abspath(os.path.join(URDF_DIR, urdf))
+                request.pose = Pose()
+                # Far apart, so the models never touch each other.
+                request.pose.position.x = 3.0 * call
+                request.pose.position.y = 3.0 * index
+                request.pose.position.z = 1.0
+                request.pose.orientation.w = 1.0
+                request.twist = Twist()
+                request.friction = -1.0
+                request.restitution = -1.0
+                start = time.perf_counter()
+                response = spawn(request)
+                times.append(1e3 * (time.perf_counter() - start))
+                if not response.success:
+                    sys.exit(f'{scene}: spawn refused: {response.message}')
+            median = statistics.median(times)
+            print(f'{scene:<11} {urdf:<17} {times[0]:9.2f} {median:10.2f} {min(times):8.2f} '
+                  f'{max(times):8.2f}')
+            rows.append((scene, median, min(times), max(times)))
+        if args.csv:
+            with open(args.csv, 'a') as out:
+                for scene, median, low, high in rows:
+                    out.write(f'{scene},ours,1,,{args.calls},{median},{low},{high}' + ',' * 16 + '\n')
+    finally:
+        os.killpg(launch.pid, signal.SIGINT)
+        try:
+            launch.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            os.killpg(launch.pid, signal.SIGKILL)
+            launch.wait()
+
+
+if __name__ == '__main__':
+    main()
