@@ -7,10 +7,11 @@ SHELL := /bin/bash
 export PATH := /usr/bin:/bin:/usr/sbin:/sbin:$(PATH)
 
 ROOT := $(abspath .)
-# The catkin workspaces live under build/: rosrun does not search a package's
-# build/ directory, so the workspace inside the repository cannot make an
-# executable name ambiguous.
-WS := $(ROOT)/build/ws
+# The catkin workspaces live in hidden directories under build/: rosrun does
+# not search a package's build/, and roslaunch's and rostest's search skips
+# hidden directories, so neither follows the workspace's link back to the
+# repository nor finds an executable twice.
+WS := $(ROOT)/build/.ws
 CORE_BUILD := $(ROOT)/build/sanitize
 JOBS ?= 2
 CMAKE_ARGS ?=
@@ -65,7 +66,7 @@ test-sanitize: deps
 
 # The concurrency rostest with the node and its client built under
 # ThreadSanitizer in a second workspace; any report fails the target.
-WS_TSAN := $(ROOT)/build/ws-tsan
+WS_TSAN := $(ROOT)/build/.ws-tsan
 test-tsan: deps
 	mkdir -p $(WS_TSAN)/src
 	ln -sfn $(ROOT) $(WS_TSAN)/src/rigid_body_sim
