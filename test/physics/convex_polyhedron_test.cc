@@ -17,17 +17,10 @@
 namespace rigid_body_sim::physics {
 namespace {
 
+using testing::Contains;
 using testing::Icosphere;
 using testing::PrismMassProperties;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "\"" << text << "\" does not contain \"" << part << "\"";
-}
-
-double RelativeDifference(const Mat3& a, const Mat3& b) {
-  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
-}
+using testing::RelativeDifference;
 
 // Invariants every polyhedron must satisfy: twins run opposite ways, each
 // face loop closes and keeps its face, vertex_half_edge leaves its vertex,

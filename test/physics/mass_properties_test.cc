@@ -16,19 +16,11 @@ namespace {
 
 using testing::BoxMesh;
 using testing::CylinderMesh;
+using testing::Contains;
 using testing::Icosphere;
 using testing::kPi;
 using testing::PrismMassProperties;
-
-::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "\"" << text << "\" does not contain \"" << part << "\"";
-}
-
-// Largest entry of |a - b| relative to the largest entry of |b|.
-double RelativeDifference(const Mat3& a, const Mat3& b) {
-  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
-}
+using testing::RelativeDifference;
 
 Mat3 RandomRotation(std::mt19937& random) {
   std::normal_distribution<double> normal;

@@ -6,8 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
+
+#include <gtest/gtest.h>
 
 #include "rigid_body_sim/physics/mass_properties.h"
 
@@ -139,6 +142,16 @@ inline MassProperties PrismMassProperties(double density, double radius, double 
   const double transverse = 0.5 * polar + result.mass * length * length / 12.0;
   result.inertia_about_com = Vec3(transverse, transverse, polar).asDiagonal();
   return result;
+}
+
+inline ::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "\"" << text << "\" does not contain \"" << part << "\"";
+}
+
+// Largest entry of |a - b| relative to the largest entry of |b|.
+inline double RelativeDifference(const Mat3& a, const Mat3& b) {
+  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
 }
 
 }  // namespace rigid_body_sim::physics::testing
