@@ -253,6 +253,8 @@ Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node) {
                 &options.world.continuous_fraction),
       ReadParam(private_node, "solver/velocity_iterations", ReadInt,
                 &options.world.solver.velocity_iterations),
+      ReadParam(private_node, "solver/velocity_tolerance", ReadDouble,
+                &options.world.solver.velocity_tolerance),
       ReadParam(private_node, "solver/position_iterations", ReadInt,
                 &options.world.solver.position_iterations),
       ReadParam(private_node, "solver/collision_velocity_threshold", ReadDouble,

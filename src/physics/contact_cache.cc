@@ -17,32 +17,51 @@ std::uint64_t ContactCache::Key(std::uint32_t body_a, std::uint16_t shape_a, std
 ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_a,
                                       std::uint32_t body_b, std::uint16_t shape_b,
                                       std::uint64_t step) {
-  auto [it, inserted] = pairs_.try_emplace(Key(body_a, shape_a, body_b, shape_b));
-  ShapePairContact& entry = it->second;
-  if (inserted) {
-    entry.body_a = body_a;
-    entry.body_b = body_b;
-    entry.shape_a = shape_a;
-    entry.shape_b = shape_b;
+  const std::uint64_t key = Key(body_a, shape_a, body_b, shape_b);
+  auto it = pairs_.find(key);
+  if (it == pairs_.end()) {
+    // A frozen pair comes back with its witness and impulses.
+    if (auto frozen = frozen_.find(key); frozen != frozen_.end()) {
+      it = pairs_.insert(frozen_.extract(frozen)).position;
+      frozen_changed_ = true;
+    } else {
+      it = pairs_.try_emplace(key).first;
+      ShapePairContact& entry = it->second;
+      entry.body_a = body_a;
+      entry.body_b = body_b;
+      entry.shape_a = shape_a;
+      entry.shape_b = shape_b;
+    }
   }
-  entry.last_seen_step = step;
-  return entry;
+  it->second.last_seen_step = step;
+  return it->second;
 }
 
-void ContactCache::MatchAndPrune(std::uint64_t step,
+void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
                                  const std::function<bool(const ShapePairContact&)>& asleep) {
   touching_.clear();
   seen_.clear();
-  sleeping_.clear();
+  if (recheck_frozen) {
+    for (auto it = frozen_.begin(); it != frozen_.end();) {
+      if (asleep(it->second)) {
+        ++it;
+      } else {
+        it = frozen_.erase(it);
+        frozen_changed_ = true;
+      }
+    }
+  }
   for (auto it = pairs_.begin(); it != pairs_.end();) {
     ShapePairContact& entry = it->second;
     if (entry.last_seen_step != step) {
+      auto next = std::next(it);
       if (entry.previous_count > 0 && asleep(entry)) {
-        sleeping_.push_back(&entry);
-        ++it;
+        frozen_.insert(pairs_.extract(it));
+        frozen_changed_ = true;
       } else {
-        it = pairs_.erase(it);
+        pairs_.erase(it);
       }
+      it = next;
       continue;
     }
     for (int i = 0; i < entry.manifold.point_count; ++i) {
@@ -65,33 +84,45 @@ void ContactCache::MatchAndPrune(std::uint64_t step,
   }
   // Hash-map order depends on the insertion history; the solver's
   // Gauss-Seidel order should not.
-  auto by_key = [](const ShapePairContact* x, const ShapePairContact* y) {
-    return Key(x->body_a, x->shape_a, x->body_b, x->shape_b) <
-           Key(y->body_a, y->shape_a, y->body_b, y->shape_b);
-  };
-  std::sort(touching_.begin(), touching_.end(), by_key);
-  std::sort(seen_.begin(), seen_.end(), by_key);
-  std::sort(sleeping_.begin(), sleeping_.end(), by_key);
+  std::sort(touching_.begin(), touching_.end(), KeyLess);
+  std::sort(seen_.begin(), seen_.end(), KeyLess);
+  if (frozen_changed_) ListSleeping();
+}
+
+bool ContactCache::KeyLess(const ShapePairContact* x, const ShapePairContact* y) {
+  return Key(x->body_a, x->shape_a, x->body_b, x->shape_b) <
+         Key(y->body_a, y->shape_a, y->body_b, y->shape_b);
+}
+
+void ContactCache::ListSleeping() {
+  sleeping_.clear();
+  for (const auto& [key, entry] : frozen_) sleeping_.push_back(&entry);
+  std::sort(sleeping_.begin(), sleeping_.end(), KeyLess);
+  frozen_changed_ = false;
+  ++sleeping_version_;
 }
 
 void ContactCache::RemoveBody(std::uint32_t body) {
-  for (auto it = pairs_.begin(); it != pairs_.end();) {
-    if (it->second.body_a == body || it->second.body_b == body) {
-      it = pairs_.erase(it);
-    } else {
-      ++it;
+  for (PairMap* map : {&pairs_, &frozen_}) {
+    for (auto it = map->begin(); it != map->end();) {
+      if (it->second.body_a == body || it->second.body_b == body) {
+        it = map->erase(it);
+      } else {
+        ++it;
+      }
     }
   }
   touching_.clear();
   seen_.clear();
-  sleeping_.clear();
+  ListSleeping();
 }
 
 void ContactCache::Clear() {
   pairs_.clear();
+  frozen_.clear();
   touching_.clear();
   seen_.clear();
-  sleeping_.clear();
+  ListSleeping();
 }
 
 }  // namespace rigid_body_sim::physics

@@ -46,8 +46,11 @@ double TangentMass(const SolverBody& a, const SolverBody& b, const Vec3& r_a, co
 // Projects the tangential impulse onto the disc |t| <= limit (a circular
 // friction cone, so there is no directional bias).
 void ClampToDisc(double limit, std::array<double, 2>* tangent) {
-  const double norm = std::hypot((*tangent)[0], (*tangent)[1]);
-  if (norm > limit) {
+  // sqrt of the sum of squares: hypot's care for overflow costs more than
+  // the whole row update, and impulses are nowhere near 1e150.
+  const double norm_squared = (*tangent)[0] * (*tangent)[0] + (*tangent)[1] * (*tangent)[1];
+  if (norm_squared > limit * limit) {
+    const double norm = std::sqrt(norm_squared);
     const double scale = norm > 0.0 ? limit / norm : 0.0;
     (*tangent)[0] *= scale;
     (*tangent)[1] *= scale;
@@ -59,6 +62,9 @@ void ClampToDisc(double limit, std::array<double, 2>* tangent) {
 Status ValidateSolverSettings(const SolverSettings& settings) {
   if (settings.velocity_iterations < 1) return Status::Error("velocity_iterations must be >= 1");
   if (settings.position_iterations < 0) return Status::Error("position_iterations must be >= 0");
+  if (!(settings.velocity_tolerance >= 0.0) || !std::isfinite(settings.velocity_tolerance)) {
+    return Status::Error("velocity_tolerance must be finite and >= 0");
+  }
   if (!(settings.collision_velocity_threshold >= 0.0) ||
       !std::isfinite(settings.collision_velocity_threshold)) {
     return Status::Error("collision_velocity_threshold must be finite and >= 0");
@@ -144,9 +150,9 @@ void ContactSolver::ApplyImpulse(const SolverManifold& manifold, const SolverPoi
   SolverBody& a = bodies_[manifold.body_a];
   SolverBody& b = bodies_[manifold.body_b];
   a.linear_velocity += a.inverse_mass * impulse_world;
-  a.angular_velocity += a.inverse_inertia_world * point.r_a.cross(impulse_world);
+  a.angular_velocity += a.inverse_inertia_world.lazyProduct(point.r_a.cross(impulse_world));
   b.linear_velocity -= b.inverse_mass * impulse_world;
-  b.angular_velocity -= b.inverse_inertia_world * point.r_b.cross(impulse_world);
+  b.angular_velocity -= b.inverse_inertia_world.lazyProduct(point.r_b.cross(impulse_world));
 }
 
 double ContactSolver::CollisionSweep(const std::vector<std::pair<int, int>>& active,
@@ -243,7 +249,13 @@ void ContactSolver::ResolveCollisions() {
         if (NormalVelocity(manifold, point) < -epsilon) active.emplace_back(m, i);
       }
     }
-    if (active.empty()) return;
+    // A round of only inelastic points (e = 0) is the resting solve's LCP
+    // with v_r+ >= 0, which that solve meets for them together with every
+    // resting point; only restitution needs rounds of its own.
+    const bool elastic = std::any_of(active.begin(), active.end(), [&](const auto& entry) {
+      return manifolds_[entry.first].restitution > 0.0;
+    });
+    if (!elastic) return;
     normal.assign(active.size(), 0.0);
     tangent.assign(active.size(), {0.0, 0.0});
     bool frictionless = true;
@@ -278,80 +290,155 @@ void ContactSolver::RecordStartVelocities() {
   }
 }
 
-void ContactSolver::SolveRestingContacts() {
+// Rows of the resting solve: the touching points, copied into one array in
+// manifold order so that a sweep walks memory once.
+void ContactSolver::BuildRestingRows() {
   const double inverse_dt = 1.0 / time_step_;
-  // A point that is not touching yet is left to the time-of-impact search,
-  // so that its collision keeps its approach speed and restitution.
-  auto participates = [&](const SolverPoint& point) {
-    return point.separation <= settings_.contact_tolerance;
-  };
-
+  rows_.clear();
   for (SolverManifold& manifold : manifolds_) {
+    const SolverBody& a = bodies_[manifold.body_a];
+    const SolverBody& b = bodies_[manifold.body_b];
     for (int i = 0; i < manifold.point_count; ++i) {
       SolverPoint& point = manifold.points[i];
-      if (!participates(point)) {
+      // A point that is not touching yet is left to the time-of-impact
+      // search, so that its collision keeps its approach speed and
+      // restitution.
+      if (point.separation > settings_.contact_tolerance) {
         point.normal_impulse = 0.0;
         point.tangent_impulse = {0.0, 0.0};
         continue;
       }
-      ApplyImpulse(manifold, point,
-                   point.normal_impulse * manifold.normal_world +
-                       point.tangent_impulse[0] * manifold.tangent_world[0] +
-                       point.tangent_impulse[1] * manifold.tangent_world[1]);
+      RestingRow& row = rows_.emplace_back();
+      row.body_a = manifold.body_a;
+      row.body_b = manifold.body_b;
+      row.normal = manifold.normal_world;
+      row.tangent = manifold.tangent_world;
+      row.r_a = point.r_a;
+      row.r_b = point.r_b;
+      row.normal_mass = point.normal_mass;
+      row.tangent_mass = point.tangent_mass;
+      row.friction = manifold.friction;
+      // K t_i . n: the tangential velocity a unit normal impulse adds, with
+      // K = (1/Ma + 1/Mb) 1 - [ra]x Ia^-1 [ra]x - [rb]x Ib^-1 [rb]x. The
+      // normal part is 1/Ma + 1/Mb times t.n = 0.
+      const Vec3 ra_x_n = point.r_a.cross(row.normal);
+      const Vec3 rb_x_n = point.r_b.cross(row.normal);
+      const Vec3 wa = a.inverse_inertia_world * ra_x_n;
+      const Vec3 wb = b.inverse_inertia_world * rb_x_n;
+      for (int k = 0; k < 2; ++k) {
+        row.normal_coupling[k] =
+            point.r_a.cross(row.tangent[k]).dot(wa) + point.r_b.cross(row.tangent[k]).dot(wb);
+      }
+      row.target = std::min(
+          0.0, -2.0 * std::max(point.separation, 0.0) * inverse_dt - point.normal_velocity_start);
+      row.depth = -point.separation - settings_.penetration_slop;
+      row.normal_impulse = point.normal_impulse;
+      row.tangent_impulse = point.tangent_impulse;
+      row.point = &point;
     }
   }
+}
 
+// v_a + w_a x r_a - v_b - w_b x r_b at a row's point; with `pseudo`, the
+// split-impulse velocities instead.
+inline Vec3 ContactSolver::RowVelocity(const RestingRow& row, bool pseudo) const {
+  const SolverBody& a = bodies_[row.body_a];
+  const SolverBody& b = bodies_[row.body_b];
+  if (pseudo) {
+    return a.pseudo_linear_velocity + a.pseudo_angular_velocity.cross(row.r_a) -
+           b.pseudo_linear_velocity - b.pseudo_angular_velocity.cross(row.r_b);
+  }
+  return a.linear_velocity + a.angular_velocity.cross(row.r_a) - b.linear_velocity -
+         b.angular_velocity.cross(row.r_b);
+}
+
+inline void ContactSolver::ApplyRowImpulse(const RestingRow& row, const Vec3& impulse_world,
+                                           bool pseudo) {
+  SolverBody& a = bodies_[row.body_a];
+  SolverBody& b = bodies_[row.body_b];
+  // lazyProduct: a 3x3 product written out in place, which the general
+  // product path, a call per use, is not.
+  const Vec3 dw_a = a.inverse_inertia_world.lazyProduct(row.r_a.cross(impulse_world));
+  const Vec3 dw_b = b.inverse_inertia_world.lazyProduct(row.r_b.cross(impulse_world));
+  if (pseudo) {
+    a.pseudo_linear_velocity += a.inverse_mass * impulse_world;
+    a.pseudo_angular_velocity += dw_a;
+    b.pseudo_linear_velocity -= b.inverse_mass * impulse_world;
+    b.pseudo_angular_velocity -= dw_b;
+  } else {
+    a.linear_velocity += a.inverse_mass * impulse_world;
+    a.angular_velocity += dw_a;
+    b.linear_velocity -= b.inverse_mass * impulse_world;
+    b.angular_velocity -= dw_b;
+  }
+}
+
+void ContactSolver::SolveRestingContacts() {
+  BuildRestingRows();
+  for (const RestingRow& row : rows_) {
+    ApplyRowImpulse(row,
+                    row.normal_impulse * row.normal + row.tangent_impulse[0] * row.tangent[0] +
+                        row.tangent_impulse[1] * row.tangent[1],
+                    false);
+  }
+
+  // Projected Gauss-Seidel, one block per point: the relative velocity is
+  // read once; the friction impulse is projected onto the disc
+  // |f_t| <= mu f_n, the normal velocity is corrected by what that change
+  // adds (normal_coupling, n.K t = t.K n), the normal impulse is projected
+  // onto f >= 0, and the sum of the three changes is applied once. Sweeps stop early once no
+  // point's velocity changes by more than velocity_tolerance.
   for (int iteration = 0; iteration < settings_.velocity_iterations; ++iteration) {
-    for (SolverManifold& manifold : manifolds_) {
-      for (int i = 0; i < manifold.point_count; ++i) {
-        SolverPoint& point = manifold.points[i];
-        if (!participates(point)) continue;
-        if (manifold.friction > 0.0) {
-          const Vec3 v = RelativeVelocity(manifold, point);
-          const std::array<double, 2> old_tangent = point.tangent_impulse;
-          const Eigen::Vector2d change =
-              -point.tangent_mass *
-              Eigen::Vector2d(manifold.tangent_world[0].dot(v), manifold.tangent_world[1].dot(v));
-          point.tangent_impulse[0] += change[0];
-          point.tangent_impulse[1] += change[1];
-          ClampToDisc(manifold.friction * point.normal_impulse, &point.tangent_impulse);
-          ApplyImpulse(manifold, point,
-                       (point.tangent_impulse[0] - old_tangent[0]) * manifold.tangent_world[0] +
-                           (point.tangent_impulse[1] - old_tangent[1]) * manifold.tangent_world[1]);
+    double largest_change = 0.0;
+    for (RestingRow& row : rows_) {
+      const Vec3 v = RowVelocity(row, false);
+      Vec3 impulse = Vec3::Zero();
+      double normal_velocity = row.normal.dot(v);
+      if (row.friction > 0.0) {
+        const std::array<double, 2> old_tangent = row.tangent_impulse;
+        for (int k = 0; k < 2; ++k) {
+          row.tangent_impulse[k] -= row.tangent_mass * row.tangent[k].dot(v);
         }
-        const double target = std::min(
-            0.0, -2.0 * std::max(point.separation, 0.0) * inverse_dt - point.normal_velocity_start);
-        const double v_r = NormalVelocity(manifold, point);
-        const double old_normal = point.normal_impulse;
-        point.normal_impulse = std::max(0.0, old_normal + point.normal_mass * (target - v_r));
-        ApplyImpulse(manifold, point, (point.normal_impulse - old_normal) * manifold.normal_world);
+        ClampToDisc(row.friction * row.normal_impulse, &row.tangent_impulse);
+        for (int k = 0; k < 2; ++k) {
+          const double change = row.tangent_impulse[k] - old_tangent[k];
+          impulse += change * row.tangent[k];
+          normal_velocity += row.normal_coupling[k] * change;
+          if (row.tangent_mass > 0.0) {
+            largest_change = std::max(largest_change, std::abs(change) / row.tangent_mass);
+          }
+        }
       }
+      const double old_normal = row.normal_impulse;
+      row.normal_impulse =
+          std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
+      const double normal_change = row.normal_impulse - old_normal;
+      impulse += normal_change * row.normal;
+      if (row.normal_mass > 0.0) {
+        largest_change = std::max(largest_change, std::abs(normal_change) / row.normal_mass);
+      }
+      ApplyRowImpulse(row, impulse, false);
     }
+    if (largest_change <= settings_.velocity_tolerance) break;
   }
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
   // without touching the real velocities, so no energy is added.
+  const double inverse_dt = 1.0 / time_step_;
   for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
-    for (SolverManifold& manifold : manifolds_) {
-      SolverBody& a = bodies_[manifold.body_a];
-      SolverBody& b = bodies_[manifold.body_b];
-      for (int i = 0; i < manifold.point_count; ++i) {
-        SolverPoint& point = manifold.points[i];
-        const double depth = -point.separation - settings_.penetration_slop;
-        if (depth <= 0.0) continue;
-        const double target = settings_.position_correction * depth * inverse_dt;
-        const double v_r = manifold.normal_world.dot(
-            a.pseudo_linear_velocity + a.pseudo_angular_velocity.cross(point.r_a) -
-            b.pseudo_linear_velocity - b.pseudo_angular_velocity.cross(point.r_b));
-        const double old_impulse = point.pseudo_impulse;
-        point.pseudo_impulse = std::max(0.0, old_impulse + point.normal_mass * (target - v_r));
-        const Vec3 impulse = (point.pseudo_impulse - old_impulse) * manifold.normal_world;
-        a.pseudo_linear_velocity += a.inverse_mass * impulse;
-        a.pseudo_angular_velocity += a.inverse_inertia_world * point.r_a.cross(impulse);
-        b.pseudo_linear_velocity -= b.inverse_mass * impulse;
-        b.pseudo_angular_velocity -= b.inverse_inertia_world * point.r_b.cross(impulse);
-      }
+    for (RestingRow& row : rows_) {
+      if (row.depth <= 0.0) continue;
+      const double target = settings_.position_correction * row.depth * inverse_dt;
+      const double v_r = row.normal.dot(RowVelocity(row, true));
+      const double old_impulse = row.pseudo_impulse;
+      row.pseudo_impulse = std::max(0.0, old_impulse + row.normal_mass * (target - v_r));
+      ApplyRowImpulse(row, (row.pseudo_impulse - old_impulse) * row.normal, true);
     }
+  }
+  for (const RestingRow& row : rows_) {
+    row.point->normal_impulse = row.normal_impulse;
+    row.point->tangent_impulse = row.tangent_impulse;
+    row.point->pseudo_impulse = row.pseudo_impulse;
   }
 }
 

@@ -6,11 +6,14 @@
 namespace rigid_body_sim::physics {
 
 void World::UpdateContactCache() {
-  contact_cache_.MatchAndPrune(step_count_, [this](const ShapePairContact& pair) {
-    const Body& a = bodies_[pair.body_a];
-    const Body& b = bodies_[pair.body_b];
-    return (a.is_static || (!a.awake && !a.disabled)) && (b.is_static || (!b.awake && !b.disabled));
-  });
+  contact_cache_.MatchAndPrune(step_count_, woke_since_prune_,
+                               [this](const ShapePairContact& pair) {
+                                 const Body& a = bodies_[pair.body_a];
+                                 const Body& b = bodies_[pair.body_b];
+                                 return (a.is_static || (!a.awake && !a.disabled)) &&
+                                        (b.is_static || (!b.awake && !b.disabled));
+                               });
+  woke_since_prune_ = false;
   for (const ShapePairContact* pair : contact_cache_.touching()) {
     Body& a = bodies_[pair->body_a];
     Body& b = bodies_[pair->body_b];

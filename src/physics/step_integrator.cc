@@ -184,6 +184,7 @@ void World::DisableNonFiniteBodies() {
     if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
     body.disabled = true;
     body.awake = false;
+    woke_since_prune_ = true;
     if (body.has_proxy) {
       broad_phase_.RemoveProxy(static_cast<int>(i));
       body.has_proxy = false;

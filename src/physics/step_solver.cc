@@ -120,9 +120,23 @@ void World::SolveContacts(double dt) {
     }
   }
 
+  // Sleeping bodies keep the contacts they fell asleep with; their reports
+  // are made again only when the list of sleeping pairs changes.
+  if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
+    contacts_.clear();
+    for (const ShapePairContact* pair : contact_cache_.sleeping()) {
+      for (int i = 0; i < pair->manifold.point_count; ++i) {
+        if (pair->manifold.points[i].separation > settings_.solver.contact_tolerance) continue;
+        contacts_.push_back(MakeReport(*pair, i, dt));
+      }
+    }
+    sleeping_reports_version_ = contact_cache_.sleeping_version();
+    sleeping_report_count_ = contacts_.size();
+  }
+  contacts_.resize(sleeping_report_count_);
+
   // Keep the impulses for next step's warm start, and report the points
   // that touch.
-  contacts_.clear();
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     const SolverManifold& manifold = manifolds[m];
     ShapePairContact& pair = *pairs[m];
@@ -137,13 +151,6 @@ void World::SolveContacts(double dt) {
       report.normal_impulse = point.collision_impulse + point.normal_impulse;
       report.normal_force = report.normal_impulse / dt;
       if (report.type == ContactType::kColliding) collision_log_.push_back(report);
-    }
-  }
-  // Sleeping bodies keep the contacts they fell asleep with.
-  for (const ShapePairContact* pair : contact_cache_.sleeping()) {
-    for (int i = 0; i < pair->manifold.point_count; ++i) {
-      if (pair->manifold.points[i].separation > settings_.solver.contact_tolerance) continue;
-      contacts_.push_back(MakeReport(*pair, i, dt));
     }
   }
   if (collision_log_.size() > kMaxCollisionLogSize) {

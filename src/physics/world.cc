@@ -292,6 +292,7 @@ std::size_t World::AwakeBodyCount() const {
 void World::Wake(std::uint32_t index) {
   Body& body = bodies_[index];
   if (body.disabled) return;
+  woke_since_prune_ |= !body.awake;
   body.awake = true;
   body.sleep_time = 0.0;
 }

@@ -46,7 +46,10 @@ class ContactCache {
   // Drops the pairs not seen in `step` unless `asleep` says both of their
   // bodies sleep (their contacts still hold, frozen), matches every touching
   // manifold's points with last step's by feature id, and lists the pairs.
-  void MatchAndPrune(std::uint64_t step,
+  // Frozen pairs are set aside and cost nothing per step; pass
+  // `recheck_frozen` when a body woke or left since the last call, so that
+  // frozen pairs of bodies no longer asleep go.
+  void MatchAndPrune(std::uint64_t step, bool recheck_frozen,
                      const std::function<bool(const ShapePairContact&)>& asleep);
   // Pairs with at least one contact point this step, in a deterministic order.
   const std::vector<ShapePairContact*>& touching() const { return touching_; }
@@ -54,19 +57,28 @@ class ContactCache {
   const std::vector<ShapePairContact*>& seen() const { return seen_; }
   // Pairs of sleeping bodies, with the contacts and impulses they fell asleep with.
   const std::vector<const ShapePairContact*>& sleeping() const { return sleeping_; }
+  // Changes whenever sleeping() does.
+  std::uint64_t sleeping_version() const { return sleeping_version_; }
   // Forgets the pairs of one body (when it is destroyed or teleported).
   void RemoveBody(std::uint32_t body);
   void Clear();
-  std::size_t size() const { return pairs_.size(); }
+  std::size_t size() const { return pairs_.size() + frozen_.size(); }
 
  private:
+  using PairMap = std::unordered_map<std::uint64_t, ShapePairContact>;
   static std::uint64_t Key(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
                            std::uint16_t shape_b);
+  static bool KeyLess(const ShapePairContact* x, const ShapePairContact* y);
+  // Lists the frozen pairs in sleeping_ and bumps its version.
+  void ListSleeping();
 
-  std::unordered_map<std::uint64_t, ShapePairContact> pairs_;
+  PairMap pairs_;   // pairs the narrow phase looks at
+  PairMap frozen_;  // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
   std::vector<ShapePairContact*> seen_;
   std::vector<const ShapePairContact*> sleeping_;
+  std::uint64_t sleeping_version_ = 0;
+  bool frozen_changed_ = false;  // frozen_ differs from sleeping_
 };
 
 }  // namespace rigid_body_sim::physics

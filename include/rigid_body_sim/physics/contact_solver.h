@@ -19,8 +19,11 @@
 namespace rigid_body_sim::physics {
 
 struct SolverSettings {
-  // PGS sweeps over the resting-contact rows per step.
+  // PGS sweeps over the resting-contact rows per step, at most.
   int velocity_iterations = 20;
+  // m/s; the sweeps stop early once no point's velocity changes by more than
+  // this in a sweep (0: always velocity_iterations).
+  double velocity_tolerance = 1e-5;
   // Sweeps of the split-impulse position correction per step.
   int position_iterations = 6;
   // m/s; epsilon of the classification: colliding when v_r < -epsilon,
@@ -94,6 +97,27 @@ std::array<Vec3, 2> TangentBasis(const Vec3& normal);
 double CombineRestitution(double restitution_a, double restitution_b);
 double CombineFriction(double friction_a, double friction_b);
 
+// One touching point as the resting solve sweeps it: the manifold's frame
+// and the point's lever arms and masses copied next to its impulses.
+struct RestingRow {
+  std::uint32_t body_a = 0;
+  std::uint32_t body_b = 0;
+  Vec3 normal = Vec3::UnitZ();  // unit, world, from B to A
+  std::array<Vec3, 2> tangent{Vec3::UnitX(), Vec3::UnitY()};
+  Vec3 r_a = Vec3::Zero();  // m
+  Vec3 r_b = Vec3::Zero();
+  double normal_mass = 0.0;                 // kg
+  double tangent_mass = 0.0;                // kg
+  double friction = 0.0;                    // mu
+  std::array<double, 2> normal_coupling{};  // 1/kg, t_k . K n
+  double target = 0.0;                      // m/s, lowest v_r+ allowed
+  double depth = 0.0;                       // m, penetration beyond the slop
+  double normal_impulse = 0.0;              // N s
+  std::array<double, 2> tangent_impulse{};  // N s
+  double pseudo_impulse = 0.0;              // N s, split impulse
+  SolverPoint* point = nullptr;             // where the impulses go back
+};
+
 class ContactSolver {
  public:
   // Starts a new step: keeps the arrays' memory, clears their contents.
@@ -115,7 +139,10 @@ class ContactSolver {
   // Baraff's impulse j = -(1+e) v_r- / (1/Ma + 1/Mb + n.(Ia^-1(ra x n)) x ra
   // + n.(Ib^-1(rb x n)) x rb) (seed 000 slide 34); for several it never adds
   // energy: dE = -(1 - e^2)/2 j_c.A j_c. Points that a round made colliding
-  // (a row of balls) are resolved in the next round.
+  // (a row of balls) are resolved in the next round. Rounds stop once no
+  // colliding point has e > 0: a perfectly inelastic collision needs only
+  // v_r+ >= 0 with j >= 0 and j v_r+ = 0, which the resting solve imposes on
+  // those points (their target is 0) at the same time as on the rest.
   void ResolveCollisions();
 
   // Records v_r after the collisions and before the forces, which the
@@ -140,6 +167,9 @@ class ContactSolver {
                     const Vec3& impulse_world);
   double NormalVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
+  void BuildRestingRows();
+  Vec3 RowVelocity(const RestingRow& row, bool pseudo) const;
+  void ApplyRowImpulse(const RestingRow& row, const Vec3& impulse_world, bool pseudo);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
   // One PGS pass over the rows of the given points; returns the largest
@@ -151,6 +181,7 @@ class ContactSolver {
   double time_step_ = 1.0;
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
+  std::vector<RestingRow> rows_;
 };
 
 }  // namespace rigid_body_sim::physics

@@ -124,6 +124,11 @@ class World {
   SweepAndSortBroadPhase broad_phase_;
   std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
   ContactCache contact_cache_;
+  bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3
+  // contacts_ begins with the reports of the sleeping pairs, made when
+  // their list last changed (its version is kept here).
+  std::uint64_t sleeping_reports_version_ = ~std::uint64_t{0};
+  std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
   std::vector<Pose> start_poses_;  // world_from_principal at the start of the step
   std::vector<ContactReport> contacts_;
