@@ -61,6 +61,7 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
       input.b = &shape_b.geometry;
       input.world_from_b = world_from_shape_b;
       input.contact_distance = contact_distance;
+      entry.contact_distance = contact_distance;
       Collide(input, &entry.witness, &entry.manifold);
     }
   }

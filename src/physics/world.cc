@@ -299,6 +299,7 @@ void World::Wake(std::uint32_t index) {
 
 void World::WakeTouching(std::uint32_t index) {
   for (const ContactReport& contact : contacts_) {
+    if (contact.body_a.index != index && contact.body_b.index != index) continue;
     for (const BodyId other : {contact.body_a, contact.body_b}) {
       if (other.index != index && IsValid(other) && !bodies_[other.index].is_static) {
         Wake(other.index);

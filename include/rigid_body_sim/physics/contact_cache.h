@@ -30,6 +30,9 @@ struct ShapePairContact {
   std::uint16_t shape_b = 0;
   SeparatingWitness witness;
   ContactManifold manifold;  // this step's
+  // m; the narrow phase reported points closer than this, so with none the
+  // shapes are at least this far apart.
+  double contact_distance = 0.0;
   // Warm start for this step's points, matched by feature id.
   std::array<CachedImpulse, ContactManifold::kMaxPoints> warm_start{};
   // Last step's points and their final impulses.
