@@ -249,6 +249,8 @@ Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node) {
       ReadParam(private_node, "max_hull_vertices", ReadInt, &options.max_hull_vertices),
       ReadParam(private_node, "cylinder_segments", ReadInt, &options.cylinder_segments),
       ReadParam(private_node, "contact_margin", ReadDouble, &options.world.contact_margin),
+      ReadParam(private_node, "contact_reuse_distance", ReadDouble,
+                &options.world.contact_reuse_distance),
       ReadParam(private_node, "continuous_fraction", ReadDouble,
                 &options.world.continuous_fraction),
       ReadParam(private_node, "solver/velocity_iterations", ReadInt,

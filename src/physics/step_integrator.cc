@@ -120,7 +120,7 @@ void World::IntegrateBodies(double dt) {
   // groups of linked impacts instead would let one grazing pair hold every
   // body of a pile at the start of its step, step after step.
   std::vector<double> impact_time(bodies_.size(), std::numeric_limits<double>::infinity());
-  for (const ShapePairContact* pair : contact_cache_.seen()) {
+  for (ShapePairContact* pair : contact_cache_.seen()) {
     // The gap at the start: the nearest point of the manifold, or, with no
     // point, at least the distance the narrow phase looked within.
     double start_gap = pair->contact_distance;
@@ -130,9 +130,10 @@ void World::IntegrateBodies(double dt) {
     const bool fast = is_fast(pair->body_a) || is_fast(pair->body_b);
     if (start_gap <= touching && !fast) continue;
     if (bodies_[pair->body_a].disabled || bodies_[pair->body_b].disabled) continue;
-    // Two bodies that cannot close their gap within the step need no search.
+    // Two bodies that cannot close their gap within the step need no search
+    // (a reused manifold's gap is known to within its reuse error).
     const double reach = motion_bound(pair->body_a) + motion_bound(pair->body_b);
-    if (start_gap - reach > target_gap) continue;
+    if (start_gap - pair->reuse_error - reach > target_gap) continue;
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
     const ShapeDef& shape_a = a.shapes[pair->shape_a];
@@ -189,6 +190,11 @@ void World::IntegrateBodies(double dt) {
       gap_low = gap;
     }
     if (high < 0.0) continue;
+    // The pair is about to touch: next step clips it afresh, so that the
+    // solver and this search see the same gap (a reused manifold's can be
+    // off by its reuse error, and a pair backed up to t = 0 again and
+    // again would never reach the solver).
+    pair->anchors.valid = false;
     // Regula falsi on gap(t) = aim, keeping the bracket gap(low) >
     // target_gap >= gap(high) (Illinois: the end kept twice in a row has its
     // value halved, so it converges superlinearly instead of creeping). It

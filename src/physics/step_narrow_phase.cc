@@ -28,6 +28,63 @@ void World::UpdateNarrowPhase(double dt) {
 // Body A is the moving one when only one moves, so normals point from the
 // static or sleeping body B into A. Contact points are reported up to the
 // margin plus the distance the two bodies can close in one step.
+// A face-defined manifold between polyhedra carried to the current poses
+// (the persistent manifold of Bullet and Box2D): while the relative pose of
+// the bodies has moved A's points by at most reuse_distance relative to B
+// since the manifold was clipped, each point's surface points and the
+// reference normal move with their shapes, and the separation is
+// s = n . (p_a - p_b). For a vertex on a face this is the exact distance of
+// the vertex to the face's plane, so resting contact sees exact gaps; only
+// where clipping would put the points is off, by at most the motion bound
+// |dt| + angle r_a (reuse_error).
+bool World::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
+                          const Pose& world_from_shape_b, ShapePairContact* entry) const {
+  const ManifoldAnchors& anchors = entry->anchors;
+  if (!anchors.valid || settings_.contact_reuse_distance <= 0.0) return false;
+  const double motion = (b_from_a.translation - anchors.b_from_a.translation).norm() +
+                        b_from_a.rotation.angularDistance(anchors.b_from_a.rotation) * reach_a;
+  if (!(motion <= settings_.contact_reuse_distance)) return false;
+  ContactManifold& manifold = entry->manifold;
+  manifold.normal_world =
+      (anchors.normal_turns_with_a ? world_from_shape_a.rotation : world_from_shape_b.rotation) *
+      anchors.normal_shape;
+  for (int i = 0; i < manifold.point_count; ++i) {
+    const Vec3 on_a = world_from_shape_a * anchors.on_a[i];
+    const Vec3 on_b = world_from_shape_b * anchors.on_b[i];
+    manifold.points[i].separation = manifold.normal_world.dot(on_a - on_b);
+    manifold.points[i].position_world = 0.5 * (on_a + on_b);
+  }
+  entry->reuse_error = motion;
+  return true;
+}
+
+// Records the anchors of a manifold just clipped between two polyhedra with
+// a face witness; edge/edge manifolds, spheres and half-spaces are made
+// afresh every step.
+void World::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
+                           const Pose& world_from_shape_b, ShapePairContact* entry) const {
+  ManifoldAnchors& anchors = entry->anchors;
+  const ContactManifold& manifold = entry->manifold;
+  const SeparatingWitness::Type type = entry->witness.type;
+  entry->reuse_error = 0.0;
+  anchors.valid = manifold.point_count > 0 && (type == SeparatingWitness::Type::kFaceA ||
+                                               type == SeparatingWitness::Type::kFaceB);
+  if (!anchors.valid) return;
+  anchors.b_from_a = b_from_a;
+  anchors.normal_turns_with_a = type == SeparatingWitness::Type::kFaceA;
+  const Pose& world_from_reference =
+      anchors.normal_turns_with_a ? world_from_shape_a : world_from_shape_b;
+  anchors.normal_shape = world_from_reference.rotation.conjugate() * manifold.normal_world;
+  const Pose shape_a_from_world = world_from_shape_a.Inverse();
+  const Pose shape_b_from_world = world_from_shape_b.Inverse();
+  for (int i = 0; i < manifold.point_count; ++i) {
+    const ContactPoint& point = manifold.points[i];
+    const Vec3 half_gap = 0.5 * point.separation * manifold.normal_world;
+    anchors.on_a[i] = shape_a_from_world * (point.position_world + half_gap);
+    anchors.on_b[i] = shape_b_from_world * (point.position_world - half_gap);
+  }
+}
+
 void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
   if (bodies_[body_a].is_static || !bodies_[body_a].awake) std::swap(body_a, body_b);
   const Body& a = bodies_[body_a];
@@ -62,7 +119,13 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
       input.world_from_b = world_from_shape_b;
       input.contact_distance = contact_distance;
       entry.contact_distance = contact_distance;
+      const Pose b_from_a = b.WorldFromPrincipal().Inverse() * a.WorldFromPrincipal();
+      if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b,
+                        &entry)) {
+        continue;
+      }
       Collide(input, &entry.witness, &entry.manifold);
+      AnchorManifold(b_from_a, world_from_shape_a, world_from_shape_b, &entry);
     }
   }
 }

@@ -91,6 +91,10 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
     return Status::Error("contact_margin must be finite and >= 0, got " +
                          std::to_string(settings.contact_margin));
   }
+  if (!std::isfinite(settings.contact_reuse_distance) || settings.contact_reuse_distance < 0.0) {
+    return Status::Error("contact_reuse_distance must be finite and >= 0, got " +
+                         std::to_string(settings.contact_reuse_distance));
+  }
   if (!(settings.continuous_fraction > 0.0 && settings.continuous_fraction <= 1.0)) {
     return Status::Error("continuous_fraction must be in (0, 1], got " +
                          std::to_string(settings.continuous_fraction));

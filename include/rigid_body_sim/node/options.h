@@ -18,7 +18,8 @@ namespace rigid_body_sim::node {
 struct NodeOptions {
   std::string world_frame = "world";  // ~world_frame: parent of every body frame
   // ~gravity [x, y, z] (m/s^2, default [0, 0, -9.81]), ~time_step (s, > 0,
-  // default 1/240), ~contact_margin (m, 0.005), ~continuous_fraction ((0, 1],
+  // default 1/240), ~contact_margin (m, 0.005), ~contact_reuse_distance (m,
+  // 1e-3), ~continuous_fraction ((0, 1],
   // 0.25), ~solver/{velocity_iterations (20), velocity_tolerance (m/s,
   // 1e-5), position_iterations (6),
   // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-3),

@@ -23,6 +23,19 @@ struct CachedImpulse {
   std::array<double, 2> tangent_impulse{};  // N s, in the manifold's tangent basis
 };
 
+// What a manifold between two polyhedra needs to be carried to a nearby
+// relative pose without clipping again: each point's two surface points as
+// material points of the shapes, and the reference face's normal in its own
+// shape's frame.
+struct ManifoldAnchors {
+  bool valid = false;
+  Pose b_from_a;  // principal frames of the bodies, when computed
+  bool normal_turns_with_a = true;
+  Vec3 normal_shape = Vec3::UnitZ();                     // unit, reference shape frame
+  std::array<Vec3, ContactManifold::kMaxPoints> on_a{};  // m, A's shape frame
+  std::array<Vec3, ContactManifold::kMaxPoints> on_b{};  // m, B's shape frame
+};
+
 struct ShapePairContact {
   std::uint32_t body_a = 0;  // body slot indices
   std::uint32_t body_b = 0;
@@ -33,6 +46,10 @@ struct ShapePairContact {
   // m; the narrow phase reported points closer than this, so with none the
   // shapes are at least this far apart.
   double contact_distance = 0.0;
+  ManifoldAnchors anchors;
+  // m; how far the reused manifold's points may be from where clipping would
+  // put them (0 when the manifold was clipped this step).
+  double reuse_error = 0.0;
   // Warm start for this step's points, matched by feature id.
   std::array<CachedImpulse, ContactManifold::kMaxPoints> warm_start{};
   // Last step's points and their final impulses.

@@ -31,6 +31,10 @@ struct WorldSettings {
   // A body moving more than this fraction of its thickness in one step is
   // sampled along its path, so it cannot pass through anything (0, 1].
   double continuous_fraction = 0.25;
+  // m; a manifold between two polyhedra is carried along with the bodies
+  // instead of clipped again while their relative motion since it was
+  // clipped moves no point by more than this (0: clip every step).
+  double contact_reuse_distance = 1e-3;
   SolverSettings solver;
   SleepSettings sleep;
 };
@@ -111,6 +115,10 @@ class World {
   void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
   void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
+                     const Pose& world_from_shape_b, ShapePairContact* entry) const;
+  void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
+                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void UpdateSleep(double dt);
   void DisableNonFiniteBodies();
   ContactReport MakeReport(const ShapePairContact& pair, int point, double dt) const;
