@@ -12,6 +12,7 @@ packages=(
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
   libbullet-dev libbenchmark-dev python3-matplotlib
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
+  python3-geometry-msgs python3-std-msgs
 )
 
 missing=()
