@@ -27,6 +27,7 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
     } else {
       it = pairs_.try_emplace(key).first;
       ShapePairContact& entry = it->second;
+      entry.key = key;
       entry.body_a = body_a;
       entry.body_b = body_b;
       entry.shape_a = shape_a;
@@ -90,8 +91,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
 }
 
 bool ContactCache::KeyLess(const ShapePairContact* x, const ShapePairContact* y) {
-  return Key(x->body_a, x->shape_a, x->body_b, x->shape_b) <
-         Key(y->body_a, y->shape_a, y->body_b, y->shape_b);
+  return x->key < y->key;
 }
 
 void ContactCache::ListSleeping() {

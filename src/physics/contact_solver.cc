@@ -317,17 +317,22 @@ void ContactSolver::BuildRestingRows() {
       row.r_b = point.r_b;
       row.normal_mass = point.normal_mass;
       row.tangent_mass = point.tangent_mass;
+      row.normal_response = point.normal_mass > 0.0 ? 1.0 / point.normal_mass : 0.0;
+      row.tangent_response = point.tangent_mass > 0.0 ? 1.0 / point.tangent_mass : 0.0;
       row.friction = manifold.friction;
-      // K t_i . n: the tangential velocity a unit normal impulse adds, with
+      row.inverse_mass_a = a.inverse_mass;
+      row.inverse_mass_b = b.inverse_mass;
+      const std::array<Vec3, 3> directions{row.normal, row.tangent[0], row.tangent[1]};
+      for (int k = 0; k < 3; ++k) {
+        row.angular_a[k] = a.inverse_inertia_world * point.r_a.cross(directions[k]);
+        row.angular_b[k] = b.inverse_inertia_world * point.r_b.cross(directions[k]);
+      }
+      // K t_k . n: the tangential velocity a unit normal impulse adds, with
       // K = (1/Ma + 1/Mb) 1 - [ra]x Ia^-1 [ra]x - [rb]x Ib^-1 [rb]x. The
       // normal part is 1/Ma + 1/Mb times t.n = 0.
-      const Vec3 ra_x_n = point.r_a.cross(row.normal);
-      const Vec3 rb_x_n = point.r_b.cross(row.normal);
-      const Vec3 wa = a.inverse_inertia_world * ra_x_n;
-      const Vec3 wb = b.inverse_inertia_world * rb_x_n;
       for (int k = 0; k < 2; ++k) {
-        row.normal_coupling[k] =
-            point.r_a.cross(row.tangent[k]).dot(wa) + point.r_b.cross(row.tangent[k]).dot(wb);
+        row.normal_coupling[k] = point.r_a.cross(row.tangent[k]).dot(row.angular_a[0]) +
+                                 point.r_b.cross(row.tangent[k]).dot(row.angular_b[0]);
       }
       row.target = std::min(
           0.0, -2.0 * std::max(point.separation, 0.0) * inverse_dt - point.normal_velocity_start);
@@ -341,7 +346,8 @@ void ContactSolver::BuildRestingRows() {
 
 // v_a + w_a x r_a - v_b - w_b x r_b at a row's point; with `pseudo`, the
 // split-impulse velocities instead.
-inline Vec3 ContactSolver::RowVelocity(const RestingRow& row, bool pseudo) const {
+[[gnu::always_inline]] inline Vec3 ContactSolver::RowVelocity(const RestingRow& row,
+                                                              bool pseudo) const {
   const SolverBody& a = bodies_[row.body_a];
   const SolverBody& b = bodies_[row.body_b];
   if (pseudo) {
@@ -352,23 +358,29 @@ inline Vec3 ContactSolver::RowVelocity(const RestingRow& row, bool pseudo) const
          b.angular_velocity.cross(row.r_b);
 }
 
-inline void ContactSolver::ApplyRowImpulse(const RestingRow& row, const Vec3& impulse_world,
-                                           bool pseudo) {
+// Adds the impulse (normal, tangent 0, tangent 1) components of a row to its
+// bodies: dv = +-J / M, dw = +-sum_k j_k I^-1 (r x d_k) with the responses
+// I^-1 (r x d_k) made once per step, so a sweep does no 3x3 product.
+[[gnu::always_inline]] inline void ContactSolver::ApplyRowImpulse(const RestingRow& row,
+                                                                  const Vec3& components,
+                                                                  bool pseudo) {
   SolverBody& a = bodies_[row.body_a];
   SolverBody& b = bodies_[row.body_b];
-  // lazyProduct: a 3x3 product written out in place, which the general
-  // product path, a call per use, is not.
-  const Vec3 dw_a = a.inverse_inertia_world.lazyProduct(row.r_a.cross(impulse_world));
-  const Vec3 dw_b = b.inverse_inertia_world.lazyProduct(row.r_b.cross(impulse_world));
+  const Vec3 impulse_world =
+      components[0] * row.normal + components[1] * row.tangent[0] + components[2] * row.tangent[1];
+  const Vec3 dw_a = components[0] * row.angular_a[0] + components[1] * row.angular_a[1] +
+                    components[2] * row.angular_a[2];
+  const Vec3 dw_b = components[0] * row.angular_b[0] + components[1] * row.angular_b[1] +
+                    components[2] * row.angular_b[2];
   if (pseudo) {
-    a.pseudo_linear_velocity += a.inverse_mass * impulse_world;
+    a.pseudo_linear_velocity += row.inverse_mass_a * impulse_world;
     a.pseudo_angular_velocity += dw_a;
-    b.pseudo_linear_velocity -= b.inverse_mass * impulse_world;
+    b.pseudo_linear_velocity -= row.inverse_mass_b * impulse_world;
     b.pseudo_angular_velocity -= dw_b;
   } else {
-    a.linear_velocity += a.inverse_mass * impulse_world;
+    a.linear_velocity += row.inverse_mass_a * impulse_world;
     a.angular_velocity += dw_a;
-    b.linear_velocity -= b.inverse_mass * impulse_world;
+    b.linear_velocity -= row.inverse_mass_b * impulse_world;
     b.angular_velocity -= dw_b;
   }
 }
@@ -376,9 +388,7 @@ inline void ContactSolver::ApplyRowImpulse(const RestingRow& row, const Vec3& im
 void ContactSolver::SolveRestingContacts() {
   BuildRestingRows();
   for (const RestingRow& row : rows_) {
-    ApplyRowImpulse(row,
-                    row.normal_impulse * row.normal + row.tangent_impulse[0] * row.tangent[0] +
-                        row.tangent_impulse[1] * row.tangent[1],
+    ApplyRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]),
                     false);
   }
 
@@ -392,7 +402,7 @@ void ContactSolver::SolveRestingContacts() {
     double largest_change = 0.0;
     for (RestingRow& row : rows_) {
       const Vec3 v = RowVelocity(row, false);
-      Vec3 impulse = Vec3::Zero();
+      Vec3 change = Vec3::Zero();  // normal, tangent 0, tangent 1
       double normal_velocity = row.normal.dot(v);
       if (row.friction > 0.0) {
         const std::array<double, 2> old_tangent = row.tangent_impulse;
@@ -401,23 +411,19 @@ void ContactSolver::SolveRestingContacts() {
         }
         ClampToDisc(row.friction * row.normal_impulse, &row.tangent_impulse);
         for (int k = 0; k < 2; ++k) {
-          const double change = row.tangent_impulse[k] - old_tangent[k];
-          impulse += change * row.tangent[k];
-          normal_velocity += row.normal_coupling[k] * change;
-          if (row.tangent_mass > 0.0) {
-            largest_change = std::max(largest_change, std::abs(change) / row.tangent_mass);
-          }
+          change[k + 1] = row.tangent_impulse[k] - old_tangent[k];
+          normal_velocity += row.normal_coupling[k] * change[k + 1];
         }
+        largest_change =
+            std::max(largest_change,
+                     std::max(std::abs(change[1]), std::abs(change[2])) * row.tangent_response);
       }
       const double old_normal = row.normal_impulse;
       row.normal_impulse =
           std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
-      const double normal_change = row.normal_impulse - old_normal;
-      impulse += normal_change * row.normal;
-      if (row.normal_mass > 0.0) {
-        largest_change = std::max(largest_change, std::abs(normal_change) / row.normal_mass);
-      }
-      ApplyRowImpulse(row, impulse, false);
+      change[0] = row.normal_impulse - old_normal;
+      largest_change = std::max(largest_change, std::abs(change[0]) * row.normal_response);
+      ApplyRowImpulse(row, change, false);
     }
     if (largest_change <= settings_.velocity_tolerance) break;
   }
@@ -432,7 +438,7 @@ void ContactSolver::SolveRestingContacts() {
       const double v_r = row.normal.dot(RowVelocity(row, true));
       const double old_impulse = row.pseudo_impulse;
       row.pseudo_impulse = std::max(0.0, old_impulse + row.normal_mass * (target - v_r));
-      ApplyRowImpulse(row, (row.pseudo_impulse - old_impulse) * row.normal, true);
+      ApplyRowImpulse(row, Vec3(row.pseudo_impulse - old_impulse, 0.0, 0.0), true);
     }
   }
   for (const RestingRow& row : rows_) {

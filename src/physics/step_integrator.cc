@@ -22,7 +22,9 @@ struct BodyPath {
   Vec3 start_velocity = Vec3::Zero();   // m/s, after the collision impulses
   Vec3 end_velocity = Vec3::Zero();     // m/s
   Vec3 pseudo_velocity = Vec3::Zero();  // m/s
-  double dt = 0.0;
+  double dt = 0.0;                      // s; 0 for a body that does not move
+  bool fast = false;                    // sampled along its path
+  double reach = 0.0;                   // m, the furthest any point moves
 
   Pose At(double t) const {
     const double s = t / dt;
@@ -97,25 +99,26 @@ void World::IntegrateBodies(double dt) {
   // Pairs already touching are the resting solver's.
   const double touching = settings_.solver.contact_tolerance;
   const double target_gap = 0.5 * touching;
-  auto is_fast = [&](std::uint32_t i) {
-    const Body& body = bodies_[i];
-    if (paths[i].dt == 0.0) return false;
-    const double motion =
-        (paths[i].end.translation - paths[i].start.translation).norm() +
-        paths[i].start.rotation.angularDistance(paths[i].end.rotation) * body.bounding_radius;
-    return motion > settings_.continuous_fraction * body.thickness;
-  };
-  // How far any point of body i can move over the step, m: the centre's
-  // parabola never leaves the ball of radius dt max(|v0|, |v1|) (the
-  // velocity is linear in t), plus the split-impulse drift, plus the slerp
-  // angle times the reach of the shapes from the centre.
-  auto motion_bound = [&](std::uint32_t i) {
-    if (paths[i].dt == 0.0) return 0.0;
-    const BodyPath& path = paths[i];
-    return dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
-                 path.pseudo_velocity.norm()) +
-           path.start.rotation.angularDistance(path.end.rotation) * bodies_[i].bounding_radius;
-  };
+  // Per body, once: whether it moves more than continuous_fraction of its
+  // thickness (fast: sampled along its path), and how far any of its points
+  // can move over the step, m. The centre's parabola never leaves the ball
+  // of radius dt max(|v0|, |v1|) (the velocity is linear in t); add the
+  // split-impulse drift and the slerp angle times the shapes' reach from
+  // the centre.
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    BodyPath& path = paths[i];
+    if (path.dt == 0.0) continue;
+    const double angle = path.start.rotation.angularDistance(path.end.rotation);
+    const double radius = bodies_[i].bounding_radius;
+    const double displacement = (path.end.translation - path.start.translation).norm();
+    path.fast =
+        displacement + angle * radius > settings_.continuous_fraction * bodies_[i].thickness;
+    path.reach = dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
+                       path.pseudo_velocity.norm()) +
+                 angle * radius;
+  }
+  auto is_fast = [&](std::uint32_t i) { return paths[i].fast; };
+  auto motion_bound = [&](std::uint32_t i) { return paths[i].reach; };
   // Each body is backed up to its own earliest impact. Backing up whole
   // groups of linked impacts instead would let one grazing pair hold every
   // body of a pile at the start of its step, step after step.

@@ -37,6 +37,7 @@ struct ManifoldAnchors {
 };
 
 struct ShapePairContact {
+  std::uint64_t key = 0;     // ContactCache's key of the four indices below
   std::uint32_t body_a = 0;  // body slot indices
   std::uint32_t body_b = 0;
   std::uint16_t shape_a = 0;

@@ -106,8 +106,16 @@ struct RestingRow {
   std::array<Vec3, 2> tangent{Vec3::UnitX(), Vec3::UnitY()};
   Vec3 r_a = Vec3::Zero();  // m
   Vec3 r_b = Vec3::Zero();
+  double inverse_mass_a = 0.0;  // 1/kg
+  double inverse_mass_b = 0.0;
+  // rad/s per N s: I^-1 (r x d) for d = n, t_0, t_1, the angular velocity a
+  // unit impulse along d adds to each body.
+  std::array<Vec3, 3> angular_a{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 3> angular_b{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   double normal_mass = 0.0;                 // kg
   double tangent_mass = 0.0;                // kg
+  double normal_response = 0.0;             // 1/kg, 1 / normal_mass: m/s per N s
+  double tangent_response = 0.0;            // 1/kg, 1 / tangent_mass
   double friction = 0.0;                    // mu
   std::array<double, 2> normal_coupling{};  // 1/kg, t_k . K n
   double target = 0.0;                      // m/s, lowest v_r+ allowed
@@ -169,7 +177,7 @@ class ContactSolver {
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
   Vec3 RowVelocity(const RestingRow& row, bool pseudo) const;
-  void ApplyRowImpulse(const RestingRow& row, const Vec3& impulse_world, bool pseudo);
+  void ApplyRowImpulse(const RestingRow& row, const Vec3& components, bool pseudo);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
   // One PGS pass over the rows of the given points; returns the largest
