@@ -42,6 +42,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
                                  const std::function<bool(const ShapePairContact&)>& asleep) {
   touching_.clear();
   seen_.clear();
+  keyed_.clear();
   if (recheck_frozen) {
     for (auto it = frozen_.begin(); it != frozen_.end();) {
       if (asleep(it->second)) {
@@ -75,18 +76,19 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
         }
       }
     }
-    seen_.push_back(&entry);
-    if (entry.manifold.point_count > 0) {
-      touching_.push_back(&entry);
-    } else {
-      entry.previous_count = 0;
-    }
+    if (entry.manifold.point_count == 0) entry.previous_count = 0;
+    keyed_.emplace_back(entry.key, &entry);
     ++it;
   }
   // Hash-map order depends on the insertion history; the solver's
-  // Gauss-Seidel order should not.
-  std::sort(touching_.begin(), touching_.end(), KeyLess);
-  std::sort(seen_.begin(), seen_.end(), KeyLess);
+  // Gauss-Seidel order should not. The keys sit next to the pointers, so the
+  // sort does not chase them.
+  std::sort(keyed_.begin(), keyed_.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (const auto& [key, entry] : keyed_) {
+    seen_.push_back(entry);
+    if (entry->manifold.point_count > 0) touching_.push_back(entry);
+  }
   if (frozen_changed_) ListSleeping();
 }
 

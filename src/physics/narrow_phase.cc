@@ -145,13 +145,16 @@ bool CollidePolyhedronHalfSpace(const ConvexPolyhedron& polyhedron, const Pose& 
   const Vec3 normal = world_from_b.rotation * Vec3::UnitZ();
   const Vec3 normal_in_a = world_from_a.rotation.conjugate() * normal;
   const double plane_height = normal.dot(world_from_b.translation);
-  const Vec3 deepest = world_from_a * polyhedron.vertices[polyhedron.SupportVertex(-normal_in_a)];
-  if (!(normal.dot(deepest) - plane_height < contact_distance)) return false;
+  // s = n.(R v + t) - h = (R^T n).v + (n.t - h): no vertex is moved to the
+  // world frame unless it is kept.
+  const double height_of_a = normal.dot(world_from_a.translation) - plane_height;
+  const Vec3& deepest = polyhedron.vertices[polyhedron.SupportVertex(-normal_in_a)];
+  if (!(normal_in_a.dot(deepest) + height_of_a < contact_distance)) return false;
   kept.clear();
   for (int v = 0; v < static_cast<int>(polyhedron.vertices.size()); ++v) {
-    const Vec3 vertex = world_from_a * polyhedron.vertices[v];
-    const double separation = normal.dot(vertex) - plane_height;
+    const double separation = normal_in_a.dot(polyhedron.vertices[v]) + height_of_a;
     if (separation < contact_distance) {
+      const Vec3 vertex = world_from_a * polyhedron.vertices[v];
       kept.push_back({vertex - 0.5 * separation * normal, separation,
                       FeatureId{FeatureType::kVertexFace, static_cast<std::uint16_t>(v), 0}});
     }

@@ -16,8 +16,9 @@ Aabb PolyhedronAabb(const ConvexPolyhedron& polyhedron, const Pose& world_from_s
   if (polyhedron.vertices.size() <= kDirectAabbVertexCount) {
     Aabb box{Vec3::Constant(std::numeric_limits<double>::infinity()),
              Vec3::Constant(-std::numeric_limits<double>::infinity())};
+    const Mat3 rotation = world_from_shape.rotation.toRotationMatrix();
     for (const Vec3& vertex : polyhedron.vertices) {
-      const Vec3 vertex_world = world_from_shape * vertex;
+      const Vec3 vertex_world = Multiply(rotation, vertex) + world_from_shape.translation;
       box.min = box.min.cwiseMin(vertex_world);
       box.max = box.max.cwiseMax(vertex_world);
     }

@@ -16,21 +16,33 @@ void World::UpdateNarrowPhase(double dt) {
                   dt);
   }
   for (const std::uint32_t plane : half_space_bodies_) {
+    const Pose world_from_plane =
+        bodies_[plane].WorldFromBody() * bodies_[plane].shapes.front().body_from_shape;
+    const Vec3 normal = world_from_plane.rotation * Vec3::UnitZ();
+    const double height = normal.dot(world_from_plane.translation);
     for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
       const Body& body = bodies_[i];
-      if (body.in_use && !body.is_static && body.awake && !body.shapes.empty()) {
-        CollideBodies(i, plane, dt);
-      }
+      if (!body.in_use || body.is_static || !body.awake || body.shapes.empty()) continue;
+      // A body whose bounding sphere stays clear of the plane by the contact
+      // distance has no pair with it to look at.
+      const double clearance = normal.dot(body.position) - height - body.bounding_radius;
+      if (clearance >= ContactDistance(body, bodies_[plane], dt)) continue;
+      CollideBodies(i, plane, dt);
     }
   }
 }
 
-// Body A is the moving one when only one moves, so normals point from the
-// static or sleeping body B into A. Contact points are reported up to the
-// margin plus the distance the two bodies can close in one step.
+// m; the margin plus the distance the two bodies can close in one step.
+double World::ContactDistance(const Body& a, const Body& b, double dt) const {
+  const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
+                               a.angular_velocity.norm() * a.bounding_radius +
+                               b.angular_velocity.norm() * b.bounding_radius;
+  return settings_.contact_margin + dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
+}
+
 // A face-defined manifold between polyhedra carried to the current poses
 // (the persistent manifold of Bullet and Box2D): while the relative pose of
-// the bodies has moved A's points by at most reuse_distance relative to B
+// the bodies has moved A's points by at most contact_reuse_distance relative to B
 // since the manifold was clipped, each point's surface points and the
 // reference normal move with their shapes, and the separation is
 // s = n . (p_a - p_b). For a vertex on a face this is the exact distance of
@@ -85,15 +97,14 @@ void World::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
   }
 }
 
+// Body A is the moving one when only one moves, so normals point from the
+// static or sleeping body B into A. Contact points are reported up to the
+// margin plus the distance the two bodies can close in one step.
 void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
   if (bodies_[body_a].is_static || !bodies_[body_a].awake) std::swap(body_a, body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
-  const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
-                               a.angular_velocity.norm() * a.bounding_radius +
-                               b.angular_velocity.norm() * b.bounding_radius;
-  const double contact_distance =
-      settings_.contact_margin + dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
+  const double contact_distance = ContactDistance(a, b, dt);
   const Pose world_from_a = a.WorldFromBody();
   const Pose world_from_b = b.WorldFromBody();
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "rigid_body_sim/physics/contact.h"
@@ -97,6 +98,7 @@ class ContactCache {
   PairMap frozen_;  // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
   std::vector<ShapePairContact*> seen_;
+  std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of MatchAndPrune
   std::vector<const ShapePairContact*> sleeping_;
   std::uint64_t sleeping_version_ = 0;
   bool frozen_changed_ = false;  // frozen_ differs from sleeping_

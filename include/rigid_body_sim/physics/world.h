@@ -115,6 +115,7 @@ class World {
   void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
   void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  double ContactDistance(const Body& a, const Body& b, double dt) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
