@@ -236,6 +236,29 @@ double WitnessSeparation(const PairInA& frame, const SeparatingWitness& witness,
   return -kInfinity;
 }
 
+// The separation along a cached face witness straight from the two poses,
+// before the whole of B is moved into A's frame: the face's plane moved
+// into the other shape's frame and that shape's support vertex against it
+// (the same s as FaceOfASeparation / FaceOfBSeparation). A pair that stays
+// apart, most of the broad phase's pairs, costs two rotations and one
+// support query. -infinity for any other witness.
+double FaceWitnessSeparation(const PolyhedronPair& pair, const SeparatingWitness& witness) {
+  const bool face_of_a = witness.type == SeparatingWitness::Type::kFaceA;
+  if (!face_of_a && witness.type != SeparatingWitness::Type::kFaceB) return -kInfinity;
+  const ConvexPolyhedron& owner = face_of_a ? *pair.a : *pair.b;
+  const ConvexPolyhedron& other = face_of_a ? *pair.b : *pair.a;
+  const int face = face_of_a ? witness.index_a : witness.index_b;
+  if (face < 0 || face >= static_cast<int>(owner.faces.size())) return -kInfinity;
+  const Pose& world_from_owner = face_of_a ? pair.world_from_a : pair.world_from_b;
+  const Pose& world_from_other = face_of_a ? pair.world_from_b : pair.world_from_a;
+  const Pose other_from_owner = world_from_other.Inverse() * world_from_owner;
+  const ConvexPolyhedron::Face& plane = owner.faces[face];
+  const Vec3 normal_other = other_from_owner.rotation * plane.normal;
+  const Vec3& deepest = other.vertices[other.SupportVertex(-normal_other)];
+  // Plane in the other's frame: n'.x = d + n'.t.
+  return normal_other.dot(deepest) - plane.offset - normal_other.dot(other_from_owner.translation);
+}
+
 // Face queries first: if a face separates, the costlier edge query is
 // skipped. The best feature is face A, then face B, then the edges, each
 // only when strictly better, so ties resolve the same way every time.
@@ -501,10 +524,14 @@ bool CollidePolyhedra(const PolyhedronPair& pair, SeparatingWitness* witness,
   if (stats == nullptr) stats = &local_stats;
   *stats = CollideStats{};
   manifold->point_count = 0;
-  const PairInA frame = MakePairInA(pair);
-
   SeparatingWitness cached;
   if (witness != nullptr) cached = *witness;
+  if (FaceWitnessSeparation(pair, cached) > pair.contact_distance) {
+    stats->witness_early_out = true;
+    return false;
+  }
+  const PairInA frame = MakePairInA(pair);
+
   Vec3 cached_edge_normal = Vec3::UnitZ();
   bool cached_edges_still_face = false;
   const double cached_separation =
