@@ -35,7 +35,7 @@ struct PairInA {
   const ConvexPolyhedron* b = nullptr;
   Pose world_from_a;
   Pose a_from_b;
-  Quat b_from_a_rotation;
+  Mat3 b_from_a_matrix;  // rotation, for the per-face queries
   std::vector<Vec3>* b_vertices = nullptr;  // m, frame A
   std::vector<Vec3>* b_normals = nullptr;   // unit, frame A
 };
@@ -48,15 +48,15 @@ PairInA MakePairInA(const PolyhedronPair& pair) {
   frame.b = pair.b;
   frame.world_from_a = pair.world_from_a;
   frame.a_from_b = pair.world_from_a.Inverse() * pair.world_from_b;
-  frame.b_from_a_rotation = frame.a_from_b.rotation.conjugate();
   const Mat3 rotation = frame.a_from_b.rotation.toRotationMatrix();
+  frame.b_from_a_matrix = rotation.transpose();
   b_vertices.resize(pair.b->vertices.size());
   for (std::size_t i = 0; i < b_vertices.size(); ++i) {
-    b_vertices[i] = rotation * pair.b->vertices[i] + frame.a_from_b.translation;
+    b_vertices[i] = Multiply(rotation, pair.b->vertices[i]) + frame.a_from_b.translation;
   }
   b_normals.resize(pair.b->faces.size());
   for (std::size_t i = 0; i < b_normals.size(); ++i) {
-    b_normals[i] = rotation * pair.b->faces[i].normal;
+    b_normals[i] = Multiply(rotation, pair.b->faces[i].normal);
   }
   frame.b_vertices = &b_vertices;
   frame.b_normals = &b_normals;
@@ -67,7 +67,7 @@ PairInA MakePairInA(const PolyhedronPair& pair) {
 // along -n is its support vertex in -n, and s = n.v - d.
 double FaceOfASeparation(const PairInA& frame, int face) {
   const ConvexPolyhedron::Face& plane = frame.a->faces[face];
-  const int support = frame.b->SupportVertex(frame.b_from_a_rotation * (-plane.normal));
+  const int support = frame.b->SupportVertex(-Multiply(frame.b_from_a_matrix, plane.normal));
   return plane.normal.dot((*frame.b_vertices)[support]) - plane.offset;
 }
 
@@ -226,7 +226,7 @@ double WitnessSeparation(const PairInA& frame, const SeparatingWitness& witness,
           edge_b.normal_left, edge_b.normal_right, edge_b.normal_right.cross(edge_b.normal_left));
       *edge_normal_world = frame.world_from_a.rotation * (-axis);
       const Vec3& support_b =
-          (*frame.b_vertices)[frame.b->SupportVertex(frame.b_from_a_rotation * (-axis))];
+          (*frame.b_vertices)[frame.b->SupportVertex(-Multiply(frame.b_from_a_matrix, axis))];
       const Vec3& support_a = frame.a->vertices[frame.a->SupportVertex(axis)];
       return axis.dot(support_b - support_a);
     }

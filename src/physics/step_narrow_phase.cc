@@ -108,6 +108,7 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
   const Pose world_from_a = a.WorldFromBody();
   const Pose world_from_b = b.WorldFromBody();
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;
+  const Pose b_from_a = b.WorldFromPrincipal().Inverse() * a.WorldFromPrincipal();
   for (std::size_t i = 0; i < a.shapes.size(); ++i) {
     const ShapeDef& shape_a = a.shapes[i];
     const Pose world_from_shape_a = world_from_a * shape_a.body_from_shape;
@@ -130,7 +131,6 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
       input.world_from_b = world_from_shape_b;
       input.contact_distance = contact_distance;
       entry.contact_distance = contact_distance;
-      const Pose b_from_a = b.WorldFromPrincipal().Inverse() * a.WorldFromPrincipal();
       if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b,
                         &entry)) {
         continue;
