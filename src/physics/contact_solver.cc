@@ -317,8 +317,6 @@ void ContactSolver::BuildRestingRows() {
       row.r_b = point.r_b;
       row.normal_mass = point.normal_mass;
       row.tangent_mass = point.tangent_mass;
-      row.normal_response = point.normal_mass > 0.0 ? 1.0 / point.normal_mass : 0.0;
-      row.tangent_response = point.tangent_mass > 0.0 ? 1.0 / point.tangent_mass : 0.0;
       row.friction = manifold.friction;
       row.inverse_mass_a = a.inverse_mass;
       row.inverse_mass_b = b.inverse_mass;
@@ -396,12 +394,18 @@ void ContactSolver::SolveRestingContacts() {
   // read once; the friction impulse is projected onto the disc
   // |f_t| <= mu f_n, the normal velocity is corrected by what that change
   // adds (normal_coupling, n.K t = t.K n), the normal impulse is projected
-  // onto f >= 0, and the sum of the three changes is applied once. Sweeps stop early once no
-  // point's velocity changes by more than velocity_tolerance.
+  // onto f >= 0, and the sum of the three changes is applied once. Sweeps
+  // stop early once no point's relative velocity changed by more than
+  // velocity_tolerance since the previous sweep: the motion has converged,
+  // even where the impulses of redundant points (four corners where three
+  // would carry the load) still trade load between them.
   for (int iteration = 0; iteration < settings_.velocity_iterations; ++iteration) {
-    double largest_change = 0.0;
+    double largest_change_squared = 0.0;
     for (RestingRow& row : rows_) {
       const Vec3 v = RowVelocity(row, false);
+      largest_change_squared =
+          std::max(largest_change_squared, (v - row.last_velocity).squaredNorm());
+      row.last_velocity = v;
       Vec3 change = Vec3::Zero();  // normal, tangent 0, tangent 1
       double normal_velocity = row.normal.dot(v);
       if (row.friction > 0.0) {
@@ -414,18 +418,18 @@ void ContactSolver::SolveRestingContacts() {
           change[k + 1] = row.tangent_impulse[k] - old_tangent[k];
           normal_velocity += row.normal_coupling[k] * change[k + 1];
         }
-        largest_change =
-            std::max(largest_change,
-                     std::max(std::abs(change[1]), std::abs(change[2])) * row.tangent_response);
       }
       const double old_normal = row.normal_impulse;
       row.normal_impulse =
           std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
       change[0] = row.normal_impulse - old_normal;
-      largest_change = std::max(largest_change, std::abs(change[0]) * row.normal_response);
       ApplyRowImpulse(row, change, false);
     }
-    if (largest_change <= settings_.velocity_tolerance) break;
+    // The first sweep has no sweep before it to compare with.
+    if (iteration > 0 &&
+        largest_change_squared <= settings_.velocity_tolerance * settings_.velocity_tolerance) {
+      break;
+    }
   }
 
   // Split impulse: pseudo velocities remove penetration beyond the slop

@@ -35,7 +35,7 @@ struct PairInA {
   const ConvexPolyhedron* b = nullptr;
   Pose world_from_a;
   Pose a_from_b;
-  Mat3 b_from_a_matrix;  // rotation, for the per-face queries
+  Mat3 b_from_a_matrix;                     // rotation, for the per-face queries
   std::vector<Vec3>* b_vertices = nullptr;  // m, frame A
   std::vector<Vec3>* b_normals = nullptr;   // unit, frame A
 };

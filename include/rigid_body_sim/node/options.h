@@ -21,7 +21,7 @@ struct NodeOptions {
   // default 1/240), ~contact_margin (m, 0.005), ~contact_reuse_distance (m,
   // 1e-3), ~continuous_fraction ((0, 1],
   // 0.25), ~solver/{velocity_iterations (20), velocity_tolerance (m/s,
-  // 1e-5), position_iterations (6),
+  // 1e-6), position_iterations (6),
   // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-3),
   // penetration_slop (m, 0.5e-3), position_correction (1/step, 0.2),
   // max_collision_rounds (32), collision_iterations (30)} and

@@ -21,9 +21,10 @@ namespace rigid_body_sim::physics {
 struct SolverSettings {
   // PGS sweeps over the resting-contact rows per step, at most.
   int velocity_iterations = 20;
-  // m/s; the sweeps stop early once no point's velocity changes by more than
-  // this in a sweep (0: always velocity_iterations).
-  double velocity_tolerance = 1e-5;
+  // m/s; the sweeps stop early once no contact point's relative velocity
+  // changes by more than this from one sweep to the next (0: always
+  // velocity_iterations).
+  double velocity_tolerance = 1e-6;
   // Sweeps of the split-impulse position correction per step.
   int position_iterations = 6;
   // m/s; epsilon of the classification: colliding when v_r < -epsilon,
@@ -114,8 +115,6 @@ struct RestingRow {
   std::array<Vec3, 3> angular_b{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   double normal_mass = 0.0;                 // kg
   double tangent_mass = 0.0;                // kg
-  double normal_response = 0.0;             // 1/kg, 1 / normal_mass: m/s per N s
-  double tangent_response = 0.0;            // 1/kg, 1 / tangent_mass
   double friction = 0.0;                    // mu
   std::array<double, 2> normal_coupling{};  // 1/kg, t_k . K n
   double target = 0.0;                      // m/s, lowest v_r+ allowed
@@ -123,6 +122,7 @@ struct RestingRow {
   double normal_impulse = 0.0;              // N s
   std::array<double, 2> tangent_impulse{};  // N s
   double pseudo_impulse = 0.0;              // N s, split impulse
+  Vec3 last_velocity = Vec3::Zero();        // m/s, v_r at the previous sweep
   SolverPoint* point = nullptr;             // where the impulses go back
 };
 
