@@ -360,34 +360,23 @@ void ContactSolver::BuildRestingRows() {
 // bodies: dv = +-J / M, dw = +-sum_k j_k I^-1 (r x d_k) with the responses
 // I^-1 (r x d_k) made once per step, so a sweep does no 3x3 product.
 [[gnu::always_inline]] inline void ContactSolver::ApplyRowImpulse(const RestingRow& row,
-                                                                  const Vec3& components,
-                                                                  bool pseudo) {
+                                                                  const Vec3& components) {
   SolverBody& a = bodies_[row.body_a];
   SolverBody& b = bodies_[row.body_b];
   const Vec3 impulse_world =
       components[0] * row.normal + components[1] * row.tangent[0] + components[2] * row.tangent[1];
-  const Vec3 dw_a = components[0] * row.angular_a[0] + components[1] * row.angular_a[1] +
-                    components[2] * row.angular_a[2];
-  const Vec3 dw_b = components[0] * row.angular_b[0] + components[1] * row.angular_b[1] +
-                    components[2] * row.angular_b[2];
-  if (pseudo) {
-    a.pseudo_linear_velocity += row.inverse_mass_a * impulse_world;
-    a.pseudo_angular_velocity += dw_a;
-    b.pseudo_linear_velocity -= row.inverse_mass_b * impulse_world;
-    b.pseudo_angular_velocity -= dw_b;
-  } else {
-    a.linear_velocity += row.inverse_mass_a * impulse_world;
-    a.angular_velocity += dw_a;
-    b.linear_velocity -= row.inverse_mass_b * impulse_world;
-    b.angular_velocity -= dw_b;
-  }
+  a.linear_velocity += row.inverse_mass_a * impulse_world;
+  a.angular_velocity += components[0] * row.angular_a[0] + components[1] * row.angular_a[1] +
+                        components[2] * row.angular_a[2];
+  b.linear_velocity -= row.inverse_mass_b * impulse_world;
+  b.angular_velocity -= components[0] * row.angular_b[0] + components[1] * row.angular_b[1] +
+                        components[2] * row.angular_b[2];
 }
 
 void ContactSolver::SolveRestingContacts() {
   BuildRestingRows();
   for (const RestingRow& row : rows_) {
-    ApplyRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]),
-                    false);
+    ApplyRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]));
   }
 
   // Projected Gauss-Seidel, one block per point: the relative velocity is
@@ -423,7 +412,7 @@ void ContactSolver::SolveRestingContacts() {
       row.normal_impulse =
           std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
       change[0] = row.normal_impulse - old_normal;
-      ApplyRowImpulse(row, change, false);
+      ApplyRowImpulse(row, change);
     }
     // The first sweep has no sweep before it to compare with.
     if (iteration > 0 &&
@@ -442,7 +431,13 @@ void ContactSolver::SolveRestingContacts() {
       const double v_r = row.normal.dot(RowVelocity(row, true));
       const double old_impulse = row.pseudo_impulse;
       row.pseudo_impulse = std::max(0.0, old_impulse + row.normal_mass * (target - v_r));
-      ApplyRowImpulse(row, Vec3(row.pseudo_impulse - old_impulse, 0.0, 0.0), true);
+      const double change = row.pseudo_impulse - old_impulse;
+      SolverBody& a = bodies_[row.body_a];
+      SolverBody& b = bodies_[row.body_b];
+      a.pseudo_linear_velocity += (row.inverse_mass_a * change) * row.normal;
+      a.pseudo_angular_velocity += change * row.angular_a[0];
+      b.pseudo_linear_velocity -= (row.inverse_mass_b * change) * row.normal;
+      b.pseudo_angular_velocity -= change * row.angular_b[0];
     }
   }
   for (const RestingRow& row : rows_) {

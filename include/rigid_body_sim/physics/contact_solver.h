@@ -177,7 +177,7 @@ class ContactSolver {
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
   Vec3 RowVelocity(const RestingRow& row, bool pseudo) const;
-  void ApplyRowImpulse(const RestingRow& row, const Vec3& components, bool pseudo);
+  void ApplyRowImpulse(const RestingRow& row, const Vec3& components);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
   // One PGS pass over the rows of the given points; returns the largest
