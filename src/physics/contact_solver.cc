@@ -118,7 +118,11 @@ void ContactSolver::Prepare() {
       point.normal_velocity_before = NormalVelocity(manifold, point);
       const double epsilon = settings_.collision_velocity_threshold;
       if (point.separation > settings_.contact_tolerance) {
-        point.type = ContactType::kSeparating;
+        // Apart now, but an inelastic point (a speculative row) whose
+        // approach closes the gap within the step collides in this step.
+        const bool meets = manifold.restitution <= 0.0 && point.normal_velocity_before < -epsilon &&
+                           -point.normal_velocity_before * time_step_ >= point.separation;
+        point.type = meets ? ContactType::kColliding : ContactType::kSeparating;
       } else if (point.normal_velocity_before < -epsilon) {
         point.type = ContactType::kColliding;
       } else if (point.normal_velocity_before <= epsilon) {
@@ -302,8 +306,13 @@ void ContactSolver::BuildRestingRows() {
       SolverPoint& point = manifold.points[i];
       // A point that is not touching yet is left to the time-of-impact
       // search, so that its collision keeps its approach speed and
-      // restitution.
-      if (point.separation > settings_.contact_tolerance) {
+      // restitution, unless the manifold has none to keep (e = 0): then it
+      // is a speculative row that lets the gap close within the step but
+      // not overshoot, so a face landing on a face is held at all its
+      // corners at once instead of tipping about the first one to touch,
+      // and a column pushed from above is held at its near gaps too.
+      const bool touching = point.separation <= settings_.contact_tolerance;
+      if (!touching && manifold.restitution > 0.0) {
         point.normal_impulse = 0.0;
         point.tangent_impulse = {0.0, 0.0};
         continue;
@@ -332,8 +341,14 @@ void ContactSolver::BuildRestingRows() {
         row.normal_coupling[k] = point.r_a.cross(row.tangent[k]).dot(row.angular_a[0]) +
                                  point.r_b.cross(row.tangent[k]).dot(row.angular_b[0]);
       }
-      row.target = std::min(
-          0.0, -2.0 * std::max(point.separation, 0.0) * inverse_dt - point.normal_velocity_start);
+      // A touching point: the trapezoidal drift dt/2 (v_start + v_end) must
+      // not close the gap. A speculative point: a body its row pushes drifts
+      // dt v_end (step_solver.cc), which must close the gap exactly at most;
+      // one it does not push and that still overshoots was apart at the
+      // start, so the time-of-impact search backs it up.
+      const double gap = std::max(point.separation, 0.0);
+      row.target = std::min(0.0, touching ? -2.0 * gap * inverse_dt - point.normal_velocity_start
+                                          : -gap * inverse_dt);
       row.depth = -point.separation - settings_.penetration_slop;
       row.normal_impulse = point.normal_impulse;
       row.tangent_impulse = point.tangent_impulse;

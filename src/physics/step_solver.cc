@@ -144,7 +144,8 @@ void World::SolveContacts(double dt) {
     for (int i = 0; i < manifold.point_count; ++i) {
       const SolverPoint& point = manifold.points[i];
       pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse};
-      if (point.separation > settings_.solver.contact_tolerance) continue;
+      const bool touching = point.separation <= settings_.solver.contact_tolerance;
+      if (!touching && point.type != ContactType::kColliding) continue;
       ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, dt));
       report.normal_velocity = point.normal_velocity_before;
       report.type = point.type;
