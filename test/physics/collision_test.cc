@@ -93,6 +93,51 @@ TEST(CollisionTest, InelasticBoxDroppedFlatComesToRestWithoutRebound) {
 // A box strikes the ground on one corner with given v and omega. The result
 // must equal Baraff's impulse computed by hand (seed 000 slide 34):
 // j = -(1+e) v_r / (1/M + n.(I^-1 (r x n)) x r), P += j n, L += r x j n.
+// An inelastic box landing flat at 5 m/s on a static box yawed 0.1 rad
+// against it: the impact stops it at every corner at once, so it neither
+// tips nor slides (no horizontal motion, no spin), does not sink into the
+// box below by more than a step's worth of gravity beyond the slop, and the
+// reported collision impulse is the momentum it brought, m v.
+TEST(CollisionTest, InelasticFaceLandingStopsAtEveryCornerAtOnce) {
+  World world;
+  BoxSpec base;
+  base.size = Vec3(1.0, 1.0, 1.0);
+  base.is_static = true;
+  base.world_from_body.rotation = Quat(Eigen::AngleAxisd(0.1, Vec3::UnitZ()));
+  base.material = MakeMaterial(0.5, 0.0);
+  AddBox(&world, base);
+  BoxSpec spec;
+  spec.mass = 2.0;
+  spec.world_from_body = Translation(0.0, 0.0, 1.2);
+  spec.linear_velocity = Vec3(0.0, 0.0, -5.0);
+  spec.material = MakeMaterial(0.5, 0.0);
+  const BodyId box = AddBox(&world, spec);
+  world
+      .SetSettings([] {
+        WorldSettings settings;
+        settings.gravity = Vec3::Zero();  // the impact speed stays exactly 5 m/s
+        return settings;
+      }())
+      .ok();
+  double collision_impulse = 0.0;
+  double lowest = 1e9;
+  for (int step = 0; step < 240; ++step) {
+    world.Step();
+    for (const ContactReport& contact : world.TakeCollisionLog()) {
+      if (contact.body_a == box || contact.body_b == box)
+        collision_impulse += contact.normal_impulse;
+    }
+    lowest = std::min(lowest, world.GetPose(box).translation.z());
+  }
+  const Pose pose = world.GetPose(box);
+  EXPECT_NEAR(collision_impulse, spec.mass * 5.0, 0.02 * spec.mass * 5.0);
+  EXPECT_LT(pose.translation.head<2>().norm(), 1e-6);
+  EXPECT_LT(world.GetAngularVelocity(box).norm(), 1e-6);
+  EXPECT_LT(world.GetLinearVelocity(box).norm(), 1e-6);
+  // Resting on the top face at z = 0.5: never deeper than the slop.
+  EXPECT_GT(lowest, 1.0 - world.settings().solver.penetration_slop - 1e-6);
+}
+
 TEST(CollisionTest, CornerImpactMatchesSeedFormula) {
   WorldSettings settings;
   settings.gravity = Vec3::Zero();
