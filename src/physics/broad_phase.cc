@@ -143,7 +143,9 @@ Status SweepAndSortBroadPhase::SetAabb(int id, const Aabb& aabb_world) {
   }
   // The endpoint values are read back from the boxes when Update() scans the
   // lists in order; writing them here would touch six scattered list entries.
-  proxies_[id].aabb_world = aabb_world;
+  Aabb& stored = proxies_[id].aabb_world;
+  boxes_moved_ |= stored.min != aabb_world.min || stored.max != aabb_world.max;
+  stored = aabb_world;
   return Status::Ok();
 }
 
@@ -365,11 +367,14 @@ void SweepAndSortBroadPhase::Update() {
   }
   if (!built_ || pending_count_ > kRebuildPendingCount) {
     RebuildFromScratch();
-  } else {
+  } else if (boxes_moved_ || pending_count_ > 0) {
+    // With no box changed and none added the lists are still in order (a
+    // sleeping scene costs nothing here).
     for (int axis = 0; axis < 3; ++axis) {
       InsertionSortAxis(axis);
     }
   }
+  boxes_moved_ = false;
   for (std::uint32_t id : pending_ids_) {
     proxies_[id].pending = false;
   }

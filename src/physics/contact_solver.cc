@@ -102,7 +102,8 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
   assert(time_step > 0.0);
   settings_ = settings;
   time_step_ = time_step;
-  bodies_.assign(body_count, SolverBody());
+  // Sized, not cleared: World loads the bodies the contacts reach.
+  bodies_.resize(body_count);
   manifolds_.clear();
 }
 

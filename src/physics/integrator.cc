@@ -52,9 +52,11 @@ Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_prin
   return Quat(q1[0], q1[1], q1[2], q1[3]).normalized();
 }
 
-void IntegrateForces(const Vec3& gravity, double dt, std::vector<Body>* bodies) {
+void IntegrateForces(const Vec3& gravity, double dt, const std::vector<std::uint32_t>& moving,
+                     std::vector<Body>* bodies) {
   assert(dt > 0.0);
-  for (Body& body : *bodies) {
+  for (const std::uint32_t i : moving) {
+    Body& body = (*bodies)[i];
     if (!body.in_use || body.is_static || !body.awake) continue;
     body.start_linear_velocity = body.linear_velocity;
     body.linear_momentum += (body.mass * gravity + body.force) * dt;
@@ -65,8 +67,10 @@ void IntegrateForces(const Vec3& gravity, double dt, std::vector<Body>* bodies) 
   }
 }
 
-void IntegratePositions(double dt, std::vector<Body>* bodies) {
-  for (Body& body : *bodies) {
+void IntegratePositions(double dt, const std::vector<std::uint32_t>& moving,
+                        std::vector<Body>* bodies) {
+  for (const std::uint32_t i : moving) {
+    Body& body = (*bodies)[i];
     if (!body.in_use || body.is_static || !body.awake) continue;
     body.position += 0.5 * dt * (body.start_linear_velocity + body.linear_velocity) +
                      dt * body.pseudo_linear_velocity;

@@ -78,18 +78,18 @@ class UnionFind {
 // bracket. Pairs that cannot close their gap within the step are skipped.
 void World::IntegrateBodies(double dt) {
   std::vector<BodyPath> paths(bodies_.size());
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     const Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || !body.awake) continue;
+    if (!body.awake) continue;
     paths[i].start = body.WorldFromPrincipal();
     paths[i].start_velocity = body.start_linear_velocity;
     paths[i].end_velocity = body.linear_velocity;
     paths[i].pseudo_velocity = body.pseudo_linear_velocity;
     paths[i].dt = dt;
   }
-  IntegratePositions(dt, &bodies_);
+  IntegratePositions(dt, moving_bodies_, &bodies_);
   DisableNonFiniteBodies();
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     if (bodies_[i].disabled) paths[i].dt = 0.0;
     if (paths[i].dt > 0.0) paths[i].end = bodies_[i].WorldFromPrincipal();
   }
@@ -105,7 +105,7 @@ void World::IntegrateBodies(double dt) {
   // of radius dt max(|v0|, |v1|) (the velocity is linear in t); add the
   // split-impulse drift and the slerp angle times the shapes' reach from
   // the centre.
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     BodyPath& path = paths[i];
     if (path.dt == 0.0) continue;
     const double angle = path.start.rotation.angularDistance(path.end.rotation);
@@ -232,7 +232,7 @@ void World::IntegrateBodies(double dt) {
     impact_time[pair->body_a] = std::min(impact_time[pair->body_a], low);
     impact_time[pair->body_b] = std::min(impact_time[pair->body_b], low);
   }
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     const double time = impact_time[i];
     if (!std::isfinite(time) || paths[i].dt == 0.0) continue;
     Body& body = bodies_[i];
@@ -246,8 +246,9 @@ void World::IntegrateBodies(double dt) {
   UpdateSleep(dt);
 }
 
+// Only moving bodies change state within a step, so only they are checked.
 void World::DisableNonFiniteBodies() {
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
     if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
     body.disabled = true;
@@ -276,9 +277,9 @@ void World::UpdateSleep(double dt) {
     islands.Join(pair->body_a, pair->body_b);
   }
   std::vector<double> island_sleep_time(bodies_.size(), std::numeric_limits<double>::infinity());
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || !body.awake) continue;
+    if (!body.awake) continue;
     const bool slow =
         body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
         body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
@@ -286,9 +287,9 @@ void World::UpdateSleep(double dt) {
     double& island = island_sleep_time[islands.Find(i)];
     island = std::min(island, body.sleep_time);
   }
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+  for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || !body.awake) continue;
+    if (!body.awake) continue;
     if (island_sleep_time[islands.Find(i)] < sleep.time_to_sleep) continue;
     body.awake = false;
     body.linear_momentum.setZero();

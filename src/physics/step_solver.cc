@@ -12,14 +12,21 @@ namespace {
 // The collision log keeps at most this many points when nobody reads it.
 constexpr std::size_t kMaxCollisionLogSize = 100000;
 
-void LoadVelocities(const std::vector<Body>& bodies, std::vector<SolverBody>* solver_bodies) {
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
+// The solver's copy of the moving bodies; the other bodies the contacts
+// reach (static or asleep) get zero inverse mass and inertia. Bodies no
+// contact reaches are left as they are: the solver never reads them.
+void LoadVelocities(const std::vector<Body>& bodies, const std::vector<std::uint32_t>& moving,
+                    const std::vector<ShapePairContact*>& pairs,
+                    std::vector<SolverBody>* solver_bodies) {
+  for (const ShapePairContact* pair : pairs) {
+    (*solver_bodies)[pair->body_a] = SolverBody();
+    (*solver_bodies)[pair->body_b] = SolverBody();
+  }
+  for (const std::uint32_t i : moving) {
     const Body& body = bodies[i];
     SolverBody& solver_body = (*solver_bodies)[i];
-    if (!body.in_use || body.is_static || !body.awake) {
-      solver_body = SolverBody();
-      continue;
-    }
+    solver_body = SolverBody();
+    if (body.disabled) continue;
     solver_body.linear_velocity = body.linear_velocity;
     solver_body.angular_velocity = body.angular_velocity;
     solver_body.inverse_mass = body.inverse_mass;
@@ -28,10 +35,11 @@ void LoadVelocities(const std::vector<Body>& bodies, std::vector<SolverBody>* so
 }
 
 // P = M v and L = I_world omega, with I_world = R diag(I) R^T.
-void StoreVelocities(const std::vector<SolverBody>& solver_bodies, std::vector<Body>* bodies) {
-  for (std::size_t i = 0; i < bodies->size(); ++i) {
+void StoreVelocities(const std::vector<SolverBody>& solver_bodies,
+                     const std::vector<std::uint32_t>& moving, std::vector<Body>* bodies) {
+  for (const std::uint32_t i : moving) {
     Body& body = (*bodies)[i];
-    if (!body.in_use || body.is_static || !body.awake) continue;
+    if (body.disabled) continue;
     const SolverBody& solver_body = solver_bodies[i];
     body.linear_momentum = body.mass * solver_body.linear_velocity;
     const Mat3 rotation = body.orientation.toRotationMatrix();
@@ -68,10 +76,17 @@ ContactReport World::MakeReport(const ShapePairContact& pair, int i, double dt) 
 }
 
 void World::SolveContacts(double dt) {
+  // The bodies that move this step; the stages from here on visit only
+  // them, so sleeping bodies cost nothing.
+  moving_bodies_.clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Body& body = bodies_[i];
+    if (body.in_use && !body.is_static && body.awake && !body.disabled) moving_bodies_.push_back(i);
+  }
   solver_.Reset(settings_.solver, dt, bodies_.size());
-  LoadVelocities(bodies_, &solver_.bodies());
-  std::vector<SolverManifold>& manifolds = solver_.manifolds();
   const std::vector<ShapePairContact*>& pairs = contact_cache_.touching();
+  LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
+  std::vector<SolverManifold>& manifolds = solver_.manifolds();
   manifolds.reserve(pairs.size());
   for (const ShapePairContact* pair : pairs) {
     const Body& a = bodies_[pair->body_a];
@@ -101,12 +116,12 @@ void World::SolveContacts(double dt) {
 
   solver_.ResolveCollisions();
   solver_.RecordStartVelocities();
-  StoreVelocities(solver_.bodies(), &bodies_);
-  IntegrateForces(settings_.gravity, dt, &bodies_);
+  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
+  IntegrateForces(settings_.gravity, dt, moving_bodies_, &bodies_);
   DisableNonFiniteBodies();
-  LoadVelocities(bodies_, &solver_.bodies());
+  LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
   solver_.SolveRestingContacts();
-  StoreVelocities(solver_.bodies(), &bodies_);
+  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
   // A body that resting contact pushed this step drifts with its end
   // velocity (symplectic Euler), which keeps the momentum exchanged through
   // contacts exactly conserved; the free ones keep the trapezoid's exact

@@ -164,6 +164,7 @@ class SweepAndSortBroadPhase {
   std::size_t last_update_swaps_ = 0;
   std::size_t dead_endpoint_count_ = 0;  // per axis
   bool built_ = false;
+  bool boxes_moved_ = false;  // a SetAabb changed a box since the last Update
 };
 
 }  // namespace rigid_body_sim::physics

@@ -139,7 +139,8 @@ class World {
   std::uint64_t sleeping_reports_version_ = ~std::uint64_t{0};
   std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
-  std::vector<Pose> start_poses_;  // world_from_principal at the start of the step
+  std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
+  std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
   std::vector<BodyId> non_finite_bodies_;
