@@ -57,12 +57,14 @@ bool World::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& worl
                         b_from_a.rotation.angularDistance(anchors.b_from_a.rotation) * reach_a;
   if (!(motion <= settings_.contact_reuse_distance)) return false;
   ContactManifold& manifold = entry->manifold;
+  // Two matrices for up to nine rotations.
+  const Mat3 rotation_a = world_from_shape_a.rotation.toRotationMatrix();
+  const Mat3 rotation_b = world_from_shape_b.rotation.toRotationMatrix();
   manifold.normal_world =
-      (anchors.normal_turns_with_a ? world_from_shape_a.rotation : world_from_shape_b.rotation) *
-      anchors.normal_shape;
+      Multiply(anchors.normal_turns_with_a ? rotation_a : rotation_b, anchors.normal_shape);
   for (int i = 0; i < manifold.point_count; ++i) {
-    const Vec3 on_a = world_from_shape_a * anchors.on_a[i];
-    const Vec3 on_b = world_from_shape_b * anchors.on_b[i];
+    const Vec3 on_a = Multiply(rotation_a, anchors.on_a[i]) + world_from_shape_a.translation;
+    const Vec3 on_b = Multiply(rotation_b, anchors.on_b[i]) + world_from_shape_b.translation;
     manifold.points[i].separation = manifold.normal_world.dot(on_a - on_b);
     manifold.points[i].position_world = 0.5 * (on_a + on_b);
   }
