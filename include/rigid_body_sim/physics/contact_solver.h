@@ -164,8 +164,11 @@ class ContactSolver {
   // drift x += dt/2 (v_start + v_end) from entering the other body,
   // target = min(0, -2 max(separation, 0)/dt - v_r,start), so a body that
   // leaves the surface within the step flies free, and one held at rest is
-  // not pushed out (that is the split impulse's job). Then the split-impulse
-  // pseudo velocities that push penetrating contacts apart.
+  // not pushed out (that is the split impulse's job). Points of inelastic
+  // pairs that are still apart join as speculative rows with target
+  // min(0, -separation/dt): the gap may close within the step, not more.
+  // Then the split-impulse pseudo velocities that push penetrating contacts
+  // apart.
   void SolveRestingContacts();
 
   double time_step() const { return time_step_; }
