@@ -155,9 +155,9 @@ void ContactSolver::ApplyImpulse(const SolverManifold& manifold, const SolverPoi
   SolverBody& a = bodies_[manifold.body_a];
   SolverBody& b = bodies_[manifold.body_b];
   a.linear_velocity += a.inverse_mass * impulse_world;
-  a.angular_velocity += a.inverse_inertia_world.lazyProduct(point.r_a.cross(impulse_world));
+  a.angular_velocity += Multiply(a.inverse_inertia_world, point.r_a.cross(impulse_world));
   b.linear_velocity -= b.inverse_mass * impulse_world;
-  b.angular_velocity -= b.inverse_inertia_world.lazyProduct(point.r_b.cross(impulse_world));
+  b.angular_velocity -= Multiply(b.inverse_inertia_world, point.r_b.cross(impulse_world));
 }
 
 double ContactSolver::CollisionSweep(const std::vector<std::pair<int, int>>& active,
@@ -295,8 +295,9 @@ void ContactSolver::RecordStartVelocities() {
   }
 }
 
-// Rows of the resting solve: the touching points, copied into one array in
-// manifold order so that a sweep walks memory once.
+// Rows of the resting solve: the touching points, and the speculative ones
+// of inelastic pairs, copied into one array in manifold order so that a
+// sweep walks memory once.
 void ContactSolver::BuildRestingRows() {
   const double inverse_dt = 1.0 / time_step_;
   rows_.clear();

@@ -198,20 +198,15 @@ EdgeQuery QueryEdges(const PairInA& frame, double early_out) {
   return query;
 }
 
-// Separation along a cached witness's axis (Baraff's coherence: the plane
-// that separated last step is tried first). Edge pairs use the support
+// Separation along a cached edge-pair witness (Baraff's coherence: the
+// plane that separated last step is tried first). It uses the support
 // functions, since after motion the two edges need no longer be the
-// supports. Returns -infinity for a witness that does not fit the pair.
-double WitnessSeparation(const PairInA& frame, const SeparatingWitness& witness,
-                         Vec3* edge_normal_world, bool* still_minkowski_face) {
+// supports. Returns -infinity for a witness that does not fit the pair;
+// face witnesses are FaceWitnessSeparation's.
+double EdgeWitnessSeparation(const PairInA& frame, const SeparatingWitness& witness,
+                             Vec3* edge_normal_world, bool* still_minkowski_face) {
   *still_minkowski_face = false;
   switch (witness.type) {
-    case SeparatingWitness::Type::kFaceA:
-      if (witness.index_a < 0 || witness.index_a >= static_cast<int>(frame.a->faces.size())) break;
-      return FaceOfASeparation(frame, witness.index_a);
-    case SeparatingWitness::Type::kFaceB:
-      if (witness.index_b < 0 || witness.index_b >= static_cast<int>(frame.b->faces.size())) break;
-      return FaceOfBSeparation(frame, witness.index_b);
     case SeparatingWitness::Type::kEdges: {
       if (witness.index_a < 0 || witness.index_a >= frame.a->EdgeCount() || witness.index_b < 0 ||
           witness.index_b >= frame.b->EdgeCount()) {
@@ -231,6 +226,8 @@ double WitnessSeparation(const PairInA& frame, const SeparatingWitness& witness,
       return axis.dot(support_b - support_a);
     }
     case SeparatingWitness::Type::kNone:
+    case SeparatingWitness::Type::kFaceA:
+    case SeparatingWitness::Type::kFaceB:
       break;
   }
   return -kInfinity;
@@ -526,16 +523,20 @@ bool CollidePolyhedra(const PolyhedronPair& pair, SeparatingWitness* witness,
   manifold->point_count = 0;
   SeparatingWitness cached;
   if (witness != nullptr) cached = *witness;
-  if (FaceWitnessSeparation(pair, cached) > pair.contact_distance) {
+  const double face_separation = FaceWitnessSeparation(pair, cached);
+  if (face_separation > pair.contact_distance) {
     stats->witness_early_out = true;
     return false;
   }
   const PairInA frame = MakePairInA(pair);
 
+  // A face witness was measured above; an edge witness needs B in A's frame.
   Vec3 cached_edge_normal = Vec3::UnitZ();
   bool cached_edges_still_face = false;
   const double cached_separation =
-      WitnessSeparation(frame, cached, &cached_edge_normal, &cached_edges_still_face);
+      cached.type == SeparatingWitness::Type::kEdges
+          ? EdgeWitnessSeparation(frame, cached, &cached_edge_normal, &cached_edges_still_face)
+          : face_separation;
   if (cached_separation > pair.contact_distance) {
     stats->witness_early_out = true;
     return false;

@@ -117,8 +117,6 @@ void World::IntegrateBodies(double dt) {
                        path.pseudo_velocity.norm()) +
                  angle * radius;
   }
-  auto is_fast = [&](std::uint32_t i) { return paths[i].fast; };
-  auto motion_bound = [&](std::uint32_t i) { return paths[i].reach; };
   // Each body is backed up to its own earliest impact. Backing up whole
   // groups of linked impacts instead would let one grazing pair hold every
   // body of a pile at the start of its step, step after step.
@@ -130,12 +128,12 @@ void World::IntegrateBodies(double dt) {
     for (int i = 0; i < pair->manifold.point_count; ++i) {
       start_gap = std::min(start_gap, pair->manifold.points[i].separation);
     }
-    const bool fast = is_fast(pair->body_a) || is_fast(pair->body_b);
+    const bool fast = paths[pair->body_a].fast || paths[pair->body_b].fast;
     if (start_gap <= touching && !fast) continue;
     if (bodies_[pair->body_a].disabled || bodies_[pair->body_b].disabled) continue;
     // Two bodies that cannot close their gap within the step need no search
     // (a reused manifold's gap is known to within its reuse error).
-    const double reach = motion_bound(pair->body_a) + motion_bound(pair->body_b);
+    const double reach = paths[pair->body_a].reach + paths[pair->body_b].reach;
     if (start_gap - pair->reuse_error - reach > target_gap) continue;
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];

@@ -126,17 +126,17 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
       }
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
                                                      static_cast<std::uint16_t>(k), step_count_);
+      entry.contact_distance = contact_distance;
+      if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b,
+                        &entry)) {
+        continue;
+      }
       CollideInput input;
       input.a = &shape_a.geometry;
       input.world_from_a = world_from_shape_a;
       input.b = &shape_b.geometry;
       input.world_from_b = world_from_shape_b;
       input.contact_distance = contact_distance;
-      entry.contact_distance = contact_distance;
-      if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b,
-                        &entry)) {
-        continue;
-      }
       Collide(input, &entry.witness, &entry.manifold);
       AnchorManifold(b_from_a, world_from_shape_a, world_from_shape_b, &entry);
     }
