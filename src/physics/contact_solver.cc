@@ -359,25 +359,10 @@ void ContactSolver::BuildRestingRows() {
   }
 }
 
-// v_a + w_a x r_a - v_b - w_b x r_b at a row's point; with `pseudo`, the
-// split-impulse velocities instead.
-[[gnu::always_inline]] inline Vec3 ContactSolver::RowVelocity(const RestingRow& row,
-                                                              bool pseudo) const {
-  const SolverBody& a = bodies_[row.body_a];
-  const SolverBody& b = bodies_[row.body_b];
-  if (pseudo) {
-    return a.pseudo_linear_velocity + a.pseudo_angular_velocity.cross(row.r_a) -
-           b.pseudo_linear_velocity - b.pseudo_angular_velocity.cross(row.r_b);
-  }
-  return a.linear_velocity + a.angular_velocity.cross(row.r_a) - b.linear_velocity -
-         b.angular_velocity.cross(row.r_b);
-}
-
 // Adds the impulse (normal, tangent 0, tangent 1) components of a row to its
 // bodies: dv = +-J / M, dw = +-sum_k j_k I^-1 (r x d_k) with the responses
 // I^-1 (r x d_k) made once per step, so a sweep does no 3x3 product.
-[[gnu::always_inline]] inline void ContactSolver::ApplyRowImpulse(const RestingRow& row,
-                                                                  const Vec3& components) {
+void ContactSolver::ApplyRowImpulse(const RestingRow& row, const Vec3& components) {
   SolverBody& a = bodies_[row.body_a];
   SolverBody& b = bodies_[row.body_b];
   const Vec3 impulse_world =
@@ -405,31 +390,58 @@ void ContactSolver::SolveRestingContacts() {
   // velocity_tolerance since the previous sweep: the motion has converged,
   // even where the impulses of redundant points (four corners where three
   // would carry the load) still trade load between them.
+  //
+  // The rows of one body pair (a manifold's are adjacent) run on local
+  // copies of the two bodies' velocities, stored back after the pair's last
+  // row: one row's result reaches the next in registers, not through memory.
+  // (Plain Vec3 locals: GCC keeps a struct of all four in memory, 10 % slower.)
   for (int iteration = 0; iteration < settings_.velocity_iterations; ++iteration) {
     double largest_change_squared = 0.0;
-    for (RestingRow& row : rows_) {
-      const Vec3 v = RowVelocity(row, false);
-      largest_change_squared =
-          std::max(largest_change_squared, (v - row.last_velocity).squaredNorm());
-      row.last_velocity = v;
-      Vec3 change = Vec3::Zero();  // normal, tangent 0, tangent 1
-      double normal_velocity = row.normal.dot(v);
-      if (row.friction > 0.0) {
-        const std::array<double, 2> old_tangent = row.tangent_impulse;
-        for (int k = 0; k < 2; ++k) {
-          row.tangent_impulse[k] -= row.tangent_mass * row.tangent[k].dot(v);
+    for (std::size_t r = 0; r < rows_.size();) {
+      const std::uint32_t index_a = rows_[r].body_a;
+      const std::uint32_t index_b = rows_[r].body_b;
+      SolverBody& a = bodies_[index_a];
+      SolverBody& b = bodies_[index_b];
+      Vec3 linear_a = a.linear_velocity;
+      Vec3 angular_a = a.angular_velocity;
+      Vec3 linear_b = b.linear_velocity;
+      Vec3 angular_b = b.angular_velocity;
+      for (; r < rows_.size() && rows_[r].body_a == index_a && rows_[r].body_b == index_b; ++r) {
+        RestingRow& row = rows_[r];
+        const Vec3 v = linear_a + angular_a.cross(row.r_a) - linear_b - angular_b.cross(row.r_b);
+        largest_change_squared =
+            std::max(largest_change_squared, (v - row.last_velocity).squaredNorm());
+        row.last_velocity = v;
+        Vec3 change = Vec3::Zero();  // normal, tangent 0, tangent 1
+        double normal_velocity = row.normal.dot(v);
+        if (row.friction > 0.0) {
+          const std::array<double, 2> old_tangent = row.tangent_impulse;
+          for (int k = 0; k < 2; ++k) {
+            row.tangent_impulse[k] -= row.tangent_mass * row.tangent[k].dot(v);
+          }
+          ClampToDisc(row.friction * row.normal_impulse, &row.tangent_impulse);
+          for (int k = 0; k < 2; ++k) {
+            change[k + 1] = row.tangent_impulse[k] - old_tangent[k];
+            normal_velocity += row.normal_coupling[k] * change[k + 1];
+          }
         }
-        ClampToDisc(row.friction * row.normal_impulse, &row.tangent_impulse);
-        for (int k = 0; k < 2; ++k) {
-          change[k + 1] = row.tangent_impulse[k] - old_tangent[k];
-          normal_velocity += row.normal_coupling[k] * change[k + 1];
-        }
+        const double old_normal = row.normal_impulse;
+        row.normal_impulse =
+            std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
+        change[0] = row.normal_impulse - old_normal;
+        const Vec3 impulse_world =
+            change[0] * row.normal + change[1] * row.tangent[0] + change[2] * row.tangent[1];
+        linear_a += row.inverse_mass_a * impulse_world;
+        angular_a += change[0] * row.angular_a[0] + change[1] * row.angular_a[1] +
+                     change[2] * row.angular_a[2];
+        linear_b -= row.inverse_mass_b * impulse_world;
+        angular_b -= change[0] * row.angular_b[0] + change[1] * row.angular_b[1] +
+                     change[2] * row.angular_b[2];
       }
-      const double old_normal = row.normal_impulse;
-      row.normal_impulse =
-          std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
-      change[0] = row.normal_impulse - old_normal;
-      ApplyRowImpulse(row, change);
+      a.linear_velocity = linear_a;
+      a.angular_velocity = angular_a;
+      b.linear_velocity = linear_b;
+      b.angular_velocity = angular_b;
     }
     // The first sweep has no sweep before it to compare with.
     if (iteration > 0 &&
@@ -439,22 +451,37 @@ void ContactSolver::SolveRestingContacts() {
   }
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
-  // without touching the real velocities, so no energy is added.
+  // without touching the real velocities, so no energy is added. The same
+  // runs of rows per body pair.
   const double inverse_dt = 1.0 / time_step_;
   for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
-    for (RestingRow& row : rows_) {
-      if (row.depth <= 0.0) continue;
-      const double target = settings_.position_correction * row.depth * inverse_dt;
-      const double v_r = row.normal.dot(RowVelocity(row, true));
-      const double old_impulse = row.pseudo_impulse;
-      row.pseudo_impulse = std::max(0.0, old_impulse + row.normal_mass * (target - v_r));
-      const double change = row.pseudo_impulse - old_impulse;
-      SolverBody& a = bodies_[row.body_a];
-      SolverBody& b = bodies_[row.body_b];
-      a.pseudo_linear_velocity += (row.inverse_mass_a * change) * row.normal;
-      a.pseudo_angular_velocity += change * row.angular_a[0];
-      b.pseudo_linear_velocity -= (row.inverse_mass_b * change) * row.normal;
-      b.pseudo_angular_velocity -= change * row.angular_b[0];
+    for (std::size_t r = 0; r < rows_.size();) {
+      const std::uint32_t index_a = rows_[r].body_a;
+      const std::uint32_t index_b = rows_[r].body_b;
+      SolverBody& a = bodies_[index_a];
+      SolverBody& b = bodies_[index_b];
+      Vec3 linear_a = a.pseudo_linear_velocity;
+      Vec3 angular_a = a.pseudo_angular_velocity;
+      Vec3 linear_b = b.pseudo_linear_velocity;
+      Vec3 angular_b = b.pseudo_angular_velocity;
+      for (; r < rows_.size() && rows_[r].body_a == index_a && rows_[r].body_b == index_b; ++r) {
+        RestingRow& row = rows_[r];
+        if (row.depth <= 0.0) continue;
+        const double target = settings_.position_correction * row.depth * inverse_dt;
+        const double v_r = row.normal.dot(linear_a + angular_a.cross(row.r_a) - linear_b -
+                                          angular_b.cross(row.r_b));
+        const double old_impulse = row.pseudo_impulse;
+        row.pseudo_impulse = std::max(0.0, old_impulse + row.normal_mass * (target - v_r));
+        const double change = row.pseudo_impulse - old_impulse;
+        linear_a += (row.inverse_mass_a * change) * row.normal;
+        angular_a += change * row.angular_a[0];
+        linear_b -= (row.inverse_mass_b * change) * row.normal;
+        angular_b -= change * row.angular_b[0];
+      }
+      a.pseudo_linear_velocity = linear_a;
+      a.pseudo_angular_velocity = angular_a;
+      b.pseudo_linear_velocity = linear_b;
+      b.pseudo_angular_velocity = angular_b;
     }
   }
   for (const RestingRow& row : rows_) {

@@ -179,7 +179,6 @@ class ContactSolver {
   double NormalVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
-  Vec3 RowVelocity(const RestingRow& row, bool pseudo) const;
   void ApplyRowImpulse(const RestingRow& row, const Vec3& components);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
