@@ -160,6 +160,7 @@ class BulletEngine : public Engine {
 
   StageTimes LastStageTimes() const override {
     StageTimes times = world_.times();
+    times.velocity_iterations = solver_iterations_;
     // The points of the manifolds the solver saw: those with an awake body.
     for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) {
       const btPersistentManifold* manifold = dispatcher_.getManifoldByIndexInternal(m);
@@ -205,7 +206,6 @@ class BulletEngine : public Engine {
   // A normal row and one friction row: the default solver mode leaves out
   // SOLVER_USE_2_FRICTION_DIRECTIONS.
   int RowsPerPoint() const override { return 2; }
-  int VelocityIterations() const override { return solver_iterations_; }
 
  private:
   btDefaultCollisionConfiguration configuration_;

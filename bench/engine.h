@@ -18,6 +18,7 @@ struct StageTimes {
   double solver_ms = 0.0;
   double integrator_ms = 0.0;     // ours and Bullet's: integration and sleeping
   std::size_t solver_points = 0;  // contact points the solver saw
+  int velocity_iterations = 0;    // velocity sweeps of the solver in this step
 };
 
 class Engine {
@@ -35,10 +36,10 @@ class Engine {
   virtual double KineticEnergy() const = 0;
   // m, the deepest penetration among the current contact points.
   virtual double MaxPenetration() const = 0;
-  // Contact rows one contact point adds to a velocity iteration, and the
-  // velocity iterations per step: the denominator of the cost per row.
+  // Contact rows one contact point adds to a velocity iteration: with the
+  // points and the iterations of StageTimes, the denominator of the cost per
+  // row.
   virtual int RowsPerPoint() const = 0;
-  virtual int VelocityIterations() const = 0;
 };
 
 constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines

@@ -77,6 +77,7 @@ class OurEngine : public Engine {
     times.solver_ms = profile.solver_ms;
     times.integrator_ms = profile.integrator_ms;
     times.solver_points = profile.solver_points;
+    times.velocity_iterations = profile.velocity_sweeps;
     return times;
   }
 
@@ -104,7 +105,6 @@ class OurEngine : public Engine {
 
   // A normal row and a two-dimensional friction row (the Coulomb disc).
   int RowsPerPoint() const override { return 3; }
-  int VelocityIterations() const override { return world_->settings().solver.velocity_iterations; }
 
  private:
   std::unique_ptr<physics::World> world_;

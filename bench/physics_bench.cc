@@ -105,7 +105,7 @@ RunResult RunScene(const Scene& scene, bool bullet, double window_seconds) {
     result.integrator_ms += stages.integrator_ms;
     if (stages.solver_points > 0) {
       result.solver_point_iterations +=
-          static_cast<double>(stages.solver_points) * engine->VelocityIterations();
+          static_cast<double>(stages.solver_points) * stages.velocity_iterations;
       result.solver_rows_ms += stages.solver_ms;
     }
     result.peak_penetration = std::max(result.peak_penetration, engine->MaxPenetration());
@@ -391,8 +391,9 @@ int Main(int argc, char** argv) {
   std::printf(
       "\nstage profile, ms per step (mean of the median run); solver ns per row-iteration "
       "= solver time of the steps with contacts / (points x rows per point x velocity "
-      "iterations); ours: 3 rows per point (normal + 2-D friction), 20 iterations, and its "
-      "solver stage also holds the collision rounds and 6 position sweeps; Bullet: 2 rows "
+      "iterations); ours: 3 rows per point (normal + 2-D friction), the sweeps each step ran "
+      "(up to 20), and its solver stage also holds the collision rounds and 6 position sweeps; "
+      "Bullet: 2 rows "
       "per point, 10 iterations\n");
   std::printf("%-11s %-6s %9s %9s %9s %9s %13s\n", "scene", "engine", "broad", "narrow", "solver",
               "integr", "ns/row-iter");

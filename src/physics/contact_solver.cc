@@ -395,7 +395,8 @@ void ContactSolver::SolveRestingContacts() {
   // copies of the two bodies' velocities, stored back after the pair's last
   // row: one row's result reaches the next in registers, not through memory.
   // (Plain Vec3 locals: GCC keeps a struct of all four in memory, 10 % slower.)
-  for (int iteration = 0; iteration < settings_.velocity_iterations; ++iteration) {
+  velocity_sweeps_ = 0;
+  while (velocity_sweeps_ < settings_.velocity_iterations) {
     double largest_change_squared = 0.0;
     for (std::size_t r = 0; r < rows_.size();) {
       const std::uint32_t index_a = rows_[r].body_a;
@@ -443,8 +444,9 @@ void ContactSolver::SolveRestingContacts() {
       b.linear_velocity = linear_b;
       b.angular_velocity = angular_b;
     }
+    ++velocity_sweeps_;
     // The first sweep has no sweep before it to compare with.
-    if (iteration > 0 &&
+    if (velocity_sweeps_ > 1 &&
         largest_change_squared <= settings_.velocity_tolerance * settings_.velocity_tolerance) {
       break;
     }

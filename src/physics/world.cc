@@ -347,6 +347,7 @@ void World::Step() {
   for (const SolverManifold& manifold : solver_.manifolds()) {
     profile.solver_points += static_cast<std::size_t>(manifold.point_count);
   }
+  profile.velocity_sweeps = solver_.velocity_sweeps();
   time_ += dt;
 }
 

@@ -172,6 +172,8 @@ class ContactSolver {
   void SolveRestingContacts();
 
   double time_step() const { return time_step_; }
+  // Velocity sweeps the last SolveRestingContacts ran.
+  int velocity_sweeps() const { return velocity_sweeps_; }
 
  private:
   void ApplyImpulse(const SolverManifold& manifold, const SolverPoint& point,
@@ -189,6 +191,7 @@ class ContactSolver {
 
   SolverSettings settings_;
   double time_step_ = 1.0;
+  int velocity_sweeps_ = 0;
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
   std::vector<RestingRow> rows_;

@@ -50,6 +50,7 @@ struct StepProfile {
   double solver_ms = 0.0;         // ms, stage 4 (collisions, forces, resting contact)
   double integrator_ms = 0.0;     // ms, stage 5
   std::size_t solver_points = 0;  // contact points handed to the solver
+  int velocity_sweeps = 0;        // Gauss-Seidel sweeps of the resting solve
 };
 
 class World {
