@@ -526,6 +526,7 @@ bool CollidePolyhedra(const PolyhedronPair& pair, SeparatingWitness* witness,
   const double face_separation = FaceWitnessSeparation(pair, cached);
   if (face_separation > pair.contact_distance) {
     stats->witness_early_out = true;
+    stats->gap = face_separation;
     return false;
   }
   const PairInA frame = MakePairInA(pair);
@@ -539,12 +540,14 @@ bool CollidePolyhedra(const PolyhedronPair& pair, SeparatingWitness* witness,
           : face_separation;
   if (cached_separation > pair.contact_distance) {
     stats->witness_early_out = true;
+    stats->gap = cached_separation;
     return false;
   }
 
   const SatResult sat = RunSat(frame, pair.contact_distance);
   if (sat.separation > pair.contact_distance) {
     if (witness != nullptr) *witness = sat.witness;
+    stats->gap = sat.separation;
     return false;
   }
 

@@ -116,6 +116,7 @@ void World::IntegrateBodies(double dt) {
     path.reach = dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
                        path.pseudo_velocity.norm()) +
                  angle * radius;
+    bodies_[i].travel += path.reach;
   }
   // Each body is backed up to its own earliest impact. Backing up whole
   // groups of linked impacts instead would let one grazing pair hold every

@@ -1,6 +1,7 @@
 // Stage 2 of World::Step: a contact manifold for every pair of shapes of the
 // candidate body pairs, each starting from its cached separating witness.
 #include <algorithm>
+#include <limits>
 #include <variant>
 
 #include "rigid_body_sim/physics/narrow_phase.h"
@@ -101,32 +102,50 @@ void World::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
 
 // Body A is the moving one when only one moves, so normals point from the
 // static or sleeping body B into A. Contact points are reported up to the
-// margin plus the distance the two bodies can close in one step.
+// margin plus the distance the two bodies can close in one step. A shape
+// pair last found apart by a gap g is not looked at again while the bodies
+// have travelled less than g minus the contact distance since: no point of
+// either has moved far enough to bring them within it (conservative
+// advancement's bound, kept across steps).
 void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
   if (bodies_[body_a].is_static || !bodies_[body_a].awake) std::swap(body_a, body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
   const double contact_distance = ContactDistance(a, b, dt);
-  const Pose world_from_a = a.WorldFromBody();
-  const Pose world_from_b = b.WorldFromBody();
+  const double travel = a.travel + b.travel;
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;
-  const Pose b_from_a = b.WorldFromPrincipal().Inverse() * a.WorldFromPrincipal();
+  // The poses, made once and only for a pair that is looked at.
+  bool posed = false;
+  Pose world_from_a;
+  Pose world_from_b;
+  Pose b_from_a;
+  auto pose = [&] {
+    if (posed) return;
+    world_from_a = a.WorldFromBody();
+    world_from_b = b.WorldFromBody();
+    b_from_a = b.WorldFromPrincipal().Inverse() * a.WorldFromPrincipal();
+    posed = true;
+  };
   for (std::size_t i = 0; i < a.shapes.size(); ++i) {
     const ShapeDef& shape_a = a.shapes[i];
-    const Pose world_from_shape_a = world_from_a * shape_a.body_from_shape;
     for (std::size_t k = 0; k < b.shapes.size(); ++k) {
       const ShapeDef& shape_b = b.shapes[k];
-      const Pose world_from_shape_b = world_from_b * shape_b.body_from_shape;
       // Compound bodies: skip shape pairs whose own boxes are apart.
-      if (compound && !std::holds_alternative<HalfSpace>(shape_b.geometry) &&
-          !ShapeAabb(shape_a.geometry, world_from_shape_a)
-               .Fattened(contact_distance)
-               .Overlaps(ShapeAabb(shape_b.geometry, world_from_shape_b))) {
-        continue;
+      if (compound && !std::holds_alternative<HalfSpace>(shape_b.geometry)) {
+        pose();
+        if (!ShapeAabb(shape_a.geometry, world_from_a * shape_a.body_from_shape)
+                 .Fattened(contact_distance)
+                 .Overlaps(ShapeAabb(shape_b.geometry, world_from_b * shape_b.body_from_shape))) {
+          continue;
+        }
       }
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
                                                      static_cast<std::uint16_t>(k), step_count_);
       entry.contact_distance = contact_distance;
+      if (entry.apart_gap - (travel - entry.apart_travel) > contact_distance) continue;
+      pose();
+      const Pose world_from_shape_a = world_from_a * shape_a.body_from_shape;
+      const Pose world_from_shape_b = world_from_b * shape_b.body_from_shape;
       if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b,
                         &entry)) {
         continue;
@@ -137,7 +156,11 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
       input.b = &shape_b.geometry;
       input.world_from_b = world_from_shape_b;
       input.contact_distance = contact_distance;
-      Collide(input, &entry.witness, &entry.manifold);
+      CollideStats stats;
+      Collide(input, &entry.witness, &entry.manifold, &stats);
+      entry.apart_gap =
+          entry.manifold.point_count == 0 ? stats.gap : -std::numeric_limits<double>::infinity();
+      entry.apart_travel = travel;
       AnchorManifold(b_from_a, world_from_shape_a, world_from_shape_b, &entry);
     }
   }

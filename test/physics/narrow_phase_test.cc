@@ -249,6 +249,45 @@ TEST(NarrowPhaseWitnessTest, SeparatedPairTakesTheEarlyOutOnTheSecondCall) {
   EXPECT_EQ(manifold.point_count, 1);
 }
 
+// The gap a separated pair reports is a lower bound on the true distance
+// (GJK), whichever test found it: the full separating-axis test on the
+// first call, the cached witness on the second, after a small motion. The
+// narrow phase skips a pair until the bodies have moved by that much.
+TEST(NarrowPhaseWitnessTest, ReportedGapIsALowerBoundOnTheDistance) {
+  const ShapeGeometry box = Box(Vec3(1.0, 0.6, 0.3));
+  const ShapeGeometry other = Box(Vec3(0.4, 0.8, 1.2));
+  std::uint32_t state = 12345;
+  auto uniform = [&state](double low, double high) {
+    state = state * 1664525u + 1013904223u;
+    return low + (high - low) * (state >> 8) / double(1u << 24);
+  };
+  auto random_rotation = [&] {
+    return AxisAngle(uniform(0.0, kPi), Vec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)));
+  };
+  int tested = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Scene scene{box, MakePose(Vec3::Zero(), random_rotation()), other,
+                MakePose(Vec3(uniform(-1.5, 1.5), uniform(-1.5, 1.5), uniform(-1.5, 1.5)),
+                         random_rotation())};
+    SeparatingWitness witness;
+    for (int call = 0; call < 2; ++call) {
+      ContactManifold manifold;
+      CollideStats stats;
+      if (CollideScene(scene, 0.0, &manifold, &witness, &stats)) break;
+      const GjkInput input{&Hull(scene.a).vertices, scene.world_from_a, &Hull(scene.b).vertices,
+                           scene.world_from_b};
+      const GjkResult distance = GjkDistance(input);
+      ASSERT_TRUE(std::isfinite(stats.gap)) << "trial " << trial << ", call " << call;
+      EXPECT_GT(stats.gap, 0.0);
+      EXPECT_LE(stats.gap, distance.distance + kExact) << "trial " << trial << ", call " << call;
+      ++tested;
+      scene.world_from_b.translation += Vec3(0.01, -0.02, 0.015);
+      scene.world_from_b.rotation = AxisAngle(0.02, Vec3(1, 1, 0)) * scene.world_from_b.rotation;
+    }
+  }
+  EXPECT_GT(tested, 200);
+}
+
 TEST(NarrowPhaseWitnessTest, TouchingPairKeepsTheCachedFeatureAndTheSameManifold) {
   for (const Scene& scene : {FaceOnFace(), EdgeAcrossEdge(-0.01)}) {
     ContactManifold first;

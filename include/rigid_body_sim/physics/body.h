@@ -52,6 +52,11 @@ struct Body {
   std::vector<ShapeDef> shapes;  // in the body frame
   double thickness = 0.0;        // m, smallest width of any shape; bounds motion per sample
   double bounding_radius = 0.0;  // m, largest distance of any shape point from the centre of mass
+  // m; the steps' bounds on how far any point of the body moved, summed
+  // since it was created. A pair found apart by a gap g stays apart while
+  // the travel of its two bodies since then is below g minus the contact
+  // distance, with no need to look at it (World::CollideBodies).
+  double travel = 0.0;
 
   bool is_static = false;
   bool awake = true;

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -48,6 +49,11 @@ struct ShapePairContact {
   // m; the narrow phase reported points closer than this, so with none the
   // shapes are at least this far apart.
   double contact_distance = 0.0;
+  // With no points: a lower bound on the shapes' distance when the pair was
+  // last tested (m, -infinity when not known), and the summed travel of the
+  // two bodies then (Body::travel).
+  double apart_gap = -std::numeric_limits<double>::infinity();
+  double apart_travel = 0.0;
   ManifoldAnchors anchors;
   // m; how far the reused manifold's points may be from where clipping would
   // put them (0 when the manifold was clipped this step).

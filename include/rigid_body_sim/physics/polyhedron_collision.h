@@ -17,6 +17,9 @@ struct CollideStats {
   bool witness_early_out = false;
   // The full test ran and kept the cached feature as the defining feature.
   bool witness_kept = false;
+  // m; with no contact points, the gap along an axis that separates the
+  // shapes: a lower bound on their distance (-infinity when not known).
+  double gap = -std::numeric_limits<double>::infinity();
 };
 
 struct FaceQuery {
