@@ -117,7 +117,7 @@ Status SweepAndSortBroadPhase::RemoveProxy(int id) {
     --pending_count_;  // not sorted in yet, so in no pair
   } else {
     for (std::uint32_t other : OverlappingInListOrder(slot)) {
-      pairs_.erase(PairKey(slot, other));
+      ErasePair(PairKey(slot, other));
     }
   }
   // The endpoints stay in the lists, marked, until Update() compacts them in
@@ -173,9 +173,9 @@ Status SweepAndSortBroadPhase::SetKind(int id, ProxyKind kind) {
       continue;
     }
     if (is_dynamic) {
-      pairs_.insert(PairKey(slot, other));
+      AddPair(PairKey(slot, other));
     } else {
-      pairs_.erase(PairKey(slot, other));
+      ErasePair(PairKey(slot, other));
     }
   }
   return Status::Ok();
@@ -230,6 +230,7 @@ void SweepAndSortBroadPhase::RemoveDeadEndpoints() {
 // centres spread most, where the fewest intervals are open at once.
 void SweepAndSortBroadPhase::RebuildFromScratch() {
   pairs_.clear();
+  sorted_pairs_stale_ = true;
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<Endpoint>& list = endpoints_[axis];
     for (Endpoint& endpoint : list) {
@@ -265,7 +266,7 @@ void SweepAndSortBroadPhase::RebuildFromScratch() {
         const Proxy& other_proxy = proxies_[other];
         if (PairIsReported(proxy.kind, other_proxy.kind) &&
             proxy.aabb_world.Overlaps(other_proxy.aabb_world)) {
-          pairs_.insert(PairKey(id, other));
+          AddPair(PairKey(id, other));
         }
       }
       slot_in_open[id] = static_cast<std::uint32_t>(open.size());
@@ -336,11 +337,11 @@ void SweepAndSortBroadPhase::InsertionSortAxis(int axis) {
           const std::uint64_t key = PairKey(moving.proxy, passed.proxy);
           if (moving.is_end == 0) {
             if (moving_proxy.aabb_world.Overlaps(passed_proxy.aabb_world)) {
-              pairs_.insert(key);
+              AddPair(key);
             }
           } else if (OverlapInListOrder(moving_proxy, passed_proxy, other_axis_1) &&
                      OverlapInListOrder(moving_proxy, passed_proxy, other_axis_2)) {
-            pairs_.erase(key);
+            ErasePair(key);
           }
         }
       }
@@ -383,15 +384,26 @@ void SweepAndSortBroadPhase::Update() {
   built_ = true;
 }
 
-std::vector<ProxyPair> SweepAndSortBroadPhase::Pairs() const {
+void SweepAndSortBroadPhase::AddPair(std::uint64_t key) {
+  if (pairs_.insert(key).second) sorted_pairs_stale_ = true;
+}
+
+void SweepAndSortBroadPhase::ErasePair(std::uint64_t key) {
+  if (pairs_.erase(key) > 0) sorted_pairs_stale_ = true;
+}
+
+const std::vector<ProxyPair>& SweepAndSortBroadPhase::Pairs() const {
+  if (!sorted_pairs_stale_) return sorted_pairs_;
   std::vector<std::uint64_t> keys(pairs_.begin(), pairs_.end());
   std::sort(keys.begin(), keys.end());
-  std::vector<ProxyPair> result;
-  result.reserve(keys.size());
+  sorted_pairs_.clear();
+  sorted_pairs_.reserve(keys.size());
   for (std::uint64_t key : keys) {
-    result.push_back(ProxyPair{static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)});
+    sorted_pairs_.push_back(
+        ProxyPair{static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)});
   }
-  return result;
+  sorted_pairs_stale_ = false;
+  return sorted_pairs_;
 }
 
 bool SweepAndSortBroadPhase::HasPair(int a, int b) const {

@@ -99,8 +99,9 @@ class SweepAndSortBroadPhase {
   ProxyKind GetKind(int id) const;    // id must be in use (asserted)
 
   // The current pairs, sorted by (first, second) so that the narrow phase
-  // visits them in a deterministic order.
-  std::vector<ProxyPair> Pairs() const;
+  // visits them in a deterministic order. Sorted again only after the set
+  // changed; the reference holds until the next change.
+  const std::vector<ProxyPair>& Pairs() const;
   std::size_t PairCount() const { return pairs_.size(); }
   bool HasPair(int a, int b) const;
 
@@ -153,12 +154,17 @@ class SweepAndSortBroadPhase {
   void RemoveDeadEndpoints();
   void RebuildFromScratch();
   void InsertionSortAxis(int axis);
+  // The only ways pairs_ changes, so that Pairs() knows when to sort again.
+  void AddPair(std::uint64_t key);
+  void ErasePair(std::uint64_t key);
 
   std::vector<Proxy> proxies_;                      // indexed by id
   std::vector<std::uint32_t> free_ids_;             // ids below proxies_.size() not in use
   std::array<std::vector<Endpoint>, 3> endpoints_;  // per axis, sorted after Update()
   std::vector<std::uint32_t> pending_ids_;          // added since the last Update()
   std::unordered_set<std::uint64_t> pairs_;         // PairKey of each reported pair
+  mutable std::vector<ProxyPair> sorted_pairs_;     // pairs_ as Pairs() returns them
+  mutable bool sorted_pairs_stale_ = true;          // pairs_ changed since sorted_pairs_
   std::size_t proxy_count_ = 0;
   std::size_t pending_count_ = 0;
   std::size_t last_update_swaps_ = 0;

@@ -39,13 +39,13 @@ struct ManifoldAnchors {
 };
 
 struct ShapePairContact {
+  // The fields every visit reads first, together in one cache line.
   std::uint64_t key = 0;     // ContactCache's key of the four indices below
   std::uint32_t body_a = 0;  // body slot indices
   std::uint32_t body_b = 0;
   std::uint16_t shape_a = 0;
   std::uint16_t shape_b = 0;
-  SeparatingWitness witness;
-  ContactManifold manifold;  // this step's
+  std::uint64_t last_seen_step = 0;
   // m; the narrow phase reported points closer than this, so with none the
   // shapes are at least this far apart.
   double contact_distance = 0.0;
@@ -54,6 +54,8 @@ struct ShapePairContact {
   // two bodies then (Body::travel).
   double apart_gap = -std::numeric_limits<double>::infinity();
   double apart_travel = 0.0;
+  SeparatingWitness witness;
+  ContactManifold manifold;  // this step's
   ManifoldAnchors anchors;
   // m; how far the reused manifold's points may be from where clipping would
   // put them (0 when the manifold was clipped this step).
@@ -63,7 +65,6 @@ struct ShapePairContact {
   // Last step's points and their final impulses.
   std::array<CachedImpulse, ContactManifold::kMaxPoints> previous{};
   int previous_count = 0;
-  std::uint64_t last_seen_step = 0;
 };
 
 class ContactCache {
