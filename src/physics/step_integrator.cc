@@ -124,8 +124,13 @@ void World::IntegrateBodies(double dt) {
   std::vector<double> impact_time(bodies_.size(), std::numeric_limits<double>::infinity());
   for (ShapePairContact* pair : contact_cache_.seen()) {
     // The gap at the start: the nearest point of the manifold, or, with no
-    // point, at least the distance the narrow phase looked within.
-    double start_gap = pair->contact_distance;
+    // point, at least the distance the narrow phase looked within, and at
+    // least the narrow phase's separating-axis gap less what the bodies
+    // travelled between that test and the start of this step.
+    const double travel_since = bodies_[pair->body_a].travel - paths[pair->body_a].reach +
+                                bodies_[pair->body_b].travel - paths[pair->body_b].reach -
+                                pair->apart_travel;
+    double start_gap = std::max(pair->contact_distance, pair->apart_gap - travel_since);
     for (int i = 0; i < pair->manifold.point_count; ++i) {
       start_gap = std::min(start_gap, pair->manifold.points[i].separation);
     }
