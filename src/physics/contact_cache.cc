@@ -34,8 +34,11 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
       entry.shape_b = shape_b;
     }
   }
-  it->second.last_seen_step = step;
-  return it->second;
+  ShapePairContact& entry = it->second;
+  // Map nodes do not move, so the pointer stays good until the pair is erased.
+  if (entry.last_seen_step != step) visited_.push_back(&entry);
+  entry.last_seen_step = step;
+  return entry;
 }
 
 void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
@@ -53,42 +56,52 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
       }
     }
   }
-  for (auto it = pairs_.begin(); it != pairs_.end();) {
-    ShapePairContact& entry = it->second;
-    if (entry.last_seen_step != step) {
+  // Every pair was seen this step unless there are more pairs than visits;
+  // only then do the unseen ones have to be found and dropped or frozen.
+  if (pairs_.size() > visited_.size()) {
+    for (auto it = pairs_.begin(); it != pairs_.end();) {
+      if (it->second.last_seen_step == step) {
+        ++it;
+        continue;
+      }
       auto next = std::next(it);
-      if (entry.previous_count > 0 && asleep(entry)) {
+      if (it->second.previous_count > 0 && asleep(it->second)) {
         frozen_.insert(pairs_.extract(it));
         frozen_changed_ = true;
       } else {
         pairs_.erase(it);
       }
       it = next;
+    }
+  }
+  assert(pairs_.size() == visited_.size());
+  // The narrow phase's visits come in a deterministic order (sorted pairs,
+  // then the half-space pairs by body).
+  seen_.swap(visited_);
+  visited_.clear();
+  for (ShapePairContact* entry : seen_) {
+    if (entry->manifold.point_count == 0) {
+      entry->previous_count = 0;
       continue;
     }
-    for (int i = 0; i < entry.manifold.point_count; ++i) {
-      CachedImpulse& warm = entry.warm_start[i];
-      warm = CachedImpulse{entry.manifold.points[i].feature, 0.0, {0.0, 0.0}};
-      for (int k = 0; k < entry.previous_count; ++k) {
-        if (entry.previous[k].feature == warm.feature) {
-          warm = entry.previous[k];
+    for (int i = 0; i < entry->manifold.point_count; ++i) {
+      CachedImpulse& warm = entry->warm_start[i];
+      warm = CachedImpulse{entry->manifold.points[i].feature, 0.0, {0.0, 0.0}};
+      for (int k = 0; k < entry->previous_count; ++k) {
+        if (entry->previous[k].feature == warm.feature) {
+          warm = entry->previous[k];
           break;
         }
       }
     }
-    if (entry.manifold.point_count == 0) entry.previous_count = 0;
-    keyed_.emplace_back(entry.key, &entry);
-    ++it;
+    keyed_.emplace_back(entry->key, entry);
   }
-  // Hash-map order depends on the insertion history; the solver's
-  // Gauss-Seidel order should not. The keys sit next to the pointers, so the
-  // sort does not chase them.
+  // The solver's Gauss-Seidel order is the key order (body A's index first),
+  // whatever order the pairs were visited in. The keys sit next to the
+  // pointers, so the sort does not chase them.
   std::sort(keyed_.begin(), keyed_.end(),
             [](const auto& x, const auto& y) { return x.first < y.first; });
-  for (const auto& [key, entry] : keyed_) {
-    seen_.push_back(entry);
-    if (entry->manifold.point_count > 0) touching_.push_back(entry);
-  }
+  for (const auto& [key, entry] : keyed_) touching_.push_back(entry);
   if (frozen_changed_) ListSleeping();
 }
 
@@ -116,6 +129,7 @@ void ContactCache::RemoveBody(std::uint32_t body) {
   }
   touching_.clear();
   seen_.clear();
+  visited_.clear();
   ListSleeping();
 }
 
@@ -124,6 +138,7 @@ void ContactCache::Clear() {
   frozen_.clear();
   touching_.clear();
   seen_.clear();
+  visited_.clear();
   ListSleeping();
 }
 

@@ -80,9 +80,10 @@ class ContactCache {
   // frozen pairs of bodies no longer asleep go.
   void MatchAndPrune(std::uint64_t step, bool recheck_frozen,
                      const std::function<bool(const ShapePairContact&)>& asleep);
-  // Pairs with at least one contact point this step, in a deterministic order.
+  // Pairs with at least one contact point this step, in key order.
   const std::vector<ShapePairContact*>& touching() const { return touching_; }
-  // Every pair the narrow phase looked at this step, touching or not.
+  // Every pair the narrow phase looked at this step, touching or not, in
+  // the order it looked at them.
   const std::vector<ShapePairContact*>& seen() const { return seen_; }
   // Pairs of sleeping bodies, with the contacts and impulses they fell asleep with.
   const std::vector<const ShapePairContact*>& sleeping() const { return sleeping_; }
@@ -105,6 +106,7 @@ class ContactCache {
   PairMap frozen_;  // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
   std::vector<ShapePairContact*> seen_;
+  std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
   std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of MatchAndPrune
   std::vector<const ShapePairContact*> sleeping_;
   std::uint64_t sleeping_version_ = 0;
