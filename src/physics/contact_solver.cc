@@ -109,13 +109,9 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
 
 void ContactSolver::Prepare() {
   for (SolverManifold& manifold : manifolds_) {
-    const SolverBody& a = bodies_[manifold.body_a];
-    const SolverBody& b = bodies_[manifold.body_b];
     manifold.tangent_world = TangentBasis(manifold.normal_world);
     for (int i = 0; i < manifold.point_count; ++i) {
       SolverPoint& point = manifold.points[i];
-      point.normal_mass = EffectiveMass(a, b, point.r_a, point.r_b, manifold.normal_world);
-      point.tangent_mass = TangentMass(a, b, point.r_a, point.r_b, manifold.tangent_world);
       point.normal_velocity_before = NormalVelocity(manifold, point);
       const double epsilon = settings_.collision_velocity_threshold;
       if (point.separation > settings_.contact_tolerance) {
@@ -239,6 +235,20 @@ bool ContactSolver::SolveCompressionExactly(const std::vector<std::pair<int, int
   return true;
 }
 
+// The effective masses of every point, for the collision rounds; the
+// resting solve makes its own from the angular responses (BuildRestingRows).
+void ContactSolver::ComputeMasses() {
+  for (SolverManifold& manifold : manifolds_) {
+    const SolverBody& a = bodies_[manifold.body_a];
+    const SolverBody& b = bodies_[manifold.body_b];
+    for (int i = 0; i < manifold.point_count; ++i) {
+      SolverPoint& point = manifold.points[i];
+      point.normal_mass = EffectiveMass(a, b, point.r_a, point.r_b, manifold.normal_world);
+      point.tangent_mass = TangentMass(a, b, point.r_a, point.r_b, manifold.tangent_world);
+    }
+  }
+}
+
 void ContactSolver::ResolveCollisions() {
   const double epsilon = settings_.collision_velocity_threshold;
   std::vector<std::pair<int, int>> active;
@@ -261,6 +271,7 @@ void ContactSolver::ResolveCollisions() {
       return manifolds_[entry.first].restitution > 0.0;
     });
     if (!elastic) return;
+    if (round == 0) ComputeMasses();
     normal.assign(active.size(), 0.0);
     tangent.assign(active.size(), {0.0, 0.0});
     bool frictionless = true;
@@ -326,16 +337,24 @@ void ContactSolver::BuildRestingRows() {
       row.tangent = manifold.tangent_world;
       row.r_a = point.r_a;
       row.r_b = point.r_b;
-      row.normal_mass = point.normal_mass;
-      row.tangent_mass = point.tangent_mass;
       row.friction = manifold.friction;
       row.inverse_mass_a = a.inverse_mass;
       row.inverse_mass_b = b.inverse_mass;
       const std::array<Vec3, 3> directions{row.normal, row.tangent[0], row.tangent[1]};
+      // The responses, and from them the effective masses of EffectiveMass
+      // and TangentMass: 1/Ma + 1/Mb + sum over A, B of (r x d).I^-1 (r x d).
+      std::array<double, 3> inverse_mass_along{};
       for (int k = 0; k < 3; ++k) {
-        row.angular_a[k] = a.inverse_inertia_world * point.r_a.cross(directions[k]);
-        row.angular_b[k] = b.inverse_inertia_world * point.r_b.cross(directions[k]);
+        const Vec3 ra_x_d = point.r_a.cross(directions[k]);
+        const Vec3 rb_x_d = point.r_b.cross(directions[k]);
+        row.angular_a[k] = a.inverse_inertia_world * ra_x_d;
+        row.angular_b[k] = b.inverse_inertia_world * rb_x_d;
+        inverse_mass_along[k] = a.inverse_mass + b.inverse_mass + ra_x_d.dot(row.angular_a[k]) +
+                                rb_x_d.dot(row.angular_b[k]);
       }
+      row.normal_mass = inverse_mass_along[0] > 0.0 ? 1.0 / inverse_mass_along[0] : 0.0;
+      const double trace = inverse_mass_along[1] + inverse_mass_along[2];
+      row.tangent_mass = trace > 0.0 ? 2.0 / trace : 0.0;
       // K t_k . n: the tangential velocity a unit normal impulse adds, with
       // K = (1/Ma + 1/Mb) 1 - [ra]x Ia^-1 [ra]x - [rb]x Ib^-1 [rb]x. The
       // normal part is 1/Ma + 1/Mb times t.n = 0.

@@ -66,8 +66,8 @@ struct SolverPoint {
   Vec3 r_a = Vec3::Zero();  // m, from A's centre of mass to the contact point
   Vec3 r_b = Vec3::Zero();
   double separation = 0.0;                  // m
-  double normal_mass = 0.0;                 // 1 / (n . K n), kg
-  double tangent_mass = 0.0;                // kg, the same along both tangents
+  double normal_mass = 0.0;                 // 1 / (n . K n), kg; set for collision rounds only
+  double tangent_mass = 0.0;                // kg, the same along both tangents; likewise
   double normal_velocity_before = 0.0;      // m/s, v_r at the start of the step
   double normal_velocity_start = 0.0;       // m/s, v_r after the collisions, before the forces
   double collision_impulse = 0.0;           // N s, from the collision phase
@@ -135,9 +135,8 @@ class ContactSolver {
   std::vector<SolverManifold>& manifolds() { return manifolds_; }
   const std::vector<SolverManifold>& manifolds() const { return manifolds_; }
 
-  // Computes the effective masses and the tangent basis of every point (r_a
-  // and r_b are set by the caller), and classifies each point by v_r before
-  // anything acts.
+  // Computes the tangent basis of every manifold (r_a and r_b are set by
+  // the caller), and classifies each point by v_r before anything acts.
   void Prepare();
 
   // Colliding contact. Each round takes the points with v_r < -epsilon and
@@ -181,6 +180,7 @@ class ContactSolver {
   double NormalVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
+  void ComputeMasses();
   void ApplyRowImpulse(const RestingRow& row, const Vec3& components);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
