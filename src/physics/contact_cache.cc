@@ -18,27 +18,26 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
                                       std::uint32_t body_b, std::uint16_t shape_b,
                                       std::uint64_t step) {
   const std::uint64_t key = Key(body_a, shape_a, body_b, shape_b);
-  auto it = pairs_.find(key);
-  if (it == pairs_.end()) {
+  ShapePairContact* entry = index_.Find(key);
+  if (entry == nullptr) {
     // A frozen pair comes back with its witness and impulses.
     if (auto frozen = frozen_.find(key); frozen != frozen_.end()) {
-      it = pairs_.insert(frozen_.extract(frozen)).position;
+      entry = &pairs_.insert(frozen_.extract(frozen)).position->second;
       frozen_changed_ = true;
     } else {
-      it = pairs_.try_emplace(key).first;
-      ShapePairContact& entry = it->second;
-      entry.key = key;
-      entry.body_a = body_a;
-      entry.body_b = body_b;
-      entry.shape_a = shape_a;
-      entry.shape_b = shape_b;
+      entry = &pairs_.try_emplace(key).first->second;
+      entry->key = key;
+      entry->body_a = body_a;
+      entry->body_b = body_b;
+      entry->shape_a = shape_a;
+      entry->shape_b = shape_b;
     }
+    // Map nodes do not move, so the pointer stays good until the pair is erased.
+    index_.Insert(key, entry);
   }
-  ShapePairContact& entry = it->second;
-  // Map nodes do not move, so the pointer stays good until the pair is erased.
-  if (entry.last_seen_step != step) visited_.push_back(&entry);
-  entry.last_seen_step = step;
-  return entry;
+  if (entry->last_seen_step != step) visited_.push_back(entry);
+  entry->last_seen_step = step;
+  return *entry;
 }
 
 void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
@@ -65,6 +64,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
         continue;
       }
       auto next = std::next(it);
+      index_.Erase(it->first);
       if (it->second.previous_count > 0 && asleep(it->second)) {
         frozen_.insert(pairs_.extract(it));
         frozen_changed_ = true;
@@ -121,6 +121,7 @@ void ContactCache::RemoveBody(std::uint32_t body) {
   for (PairMap* map : {&pairs_, &frozen_}) {
     for (auto it = map->begin(); it != map->end();) {
       if (it->second.body_a == body || it->second.body_b == body) {
+        if (map == &pairs_) index_.Erase(it->first);
         it = map->erase(it);
       } else {
         ++it;
@@ -135,6 +136,7 @@ void ContactCache::RemoveBody(std::uint32_t body) {
 
 void ContactCache::Clear() {
   pairs_.clear();
+  index_.Clear();
   frozen_.clear();
   touching_.clear();
   seen_.clear();

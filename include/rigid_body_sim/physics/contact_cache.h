@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/pair_index.h"
 
 namespace rigid_body_sim::physics {
 
@@ -102,8 +103,9 @@ class ContactCache {
   // Lists the frozen pairs in sleeping_ and bumps its version.
   void ListSleeping();
 
-  PairMap pairs_;   // pairs the narrow phase looks at
-  PairMap frozen_;  // pairs of two sleeping (or static) bodies
+  PairMap pairs_;                      // pairs the narrow phase looks at
+  PairIndex<ShapePairContact> index_;  // key -> entry of pairs_, for Touch
+  PairMap frozen_;                     // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
   std::vector<ShapePairContact*> seen_;
   std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
