@@ -22,8 +22,8 @@ struct NodeOptions {
   // 1e-3), ~continuous_fraction ((0, 1],
   // 0.25), ~solver/{velocity_iterations (20), velocity_tolerance (m/s,
   // 1e-6), position_iterations (6),
-  // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-3),
-  // penetration_slop (m, 0.5e-3), position_correction (1/step, 0.2),
+  // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-5),
+  // penetration_slop (m, 1e-4), position_correction (1/step, 0.2),
   // max_collision_rounds (32), collision_iterations (30)} and
   // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
   // (rad/s, 0.1), time_to_sleep (s, 0.5)}; see physics/world.h.
