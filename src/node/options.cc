@@ -95,35 +95,23 @@ Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
   for (auto& [key, unused] : entry) {
     if (kKeys.count(key) == 0) return Status::Error(what + " has an unknown field '" + key + "'");
   }
-  Status status = Status::Ok();
   if (!entry.hasMember("name")) return Status::Error(what + " has no name");
-  if (status = ReadString(entry["name"], what + ".name", &spec->name); !status.ok()) {
-    return status;
-  }
-  if (entry.hasMember("urdf") &&
-      !(status = ReadString(entry["urdf"], what + ".urdf", &spec->urdf)).ok()) {
-    return status;
-  }
-  if (entry.hasMember("urdf_path") &&
-      !(status = ReadString(entry["urdf_path"], what + ".urdf_path", &spec->urdf_path)).ok()) {
-    return status;
-  }
-  if (entry.hasMember("is_static") &&
-      !(status = ReadBool(entry["is_static"], what + ".is_static", &spec->is_static)).ok()) {
-    return status;
-  }
-  if (entry.hasMember("friction") &&
-      !(status = ReadDouble(entry["friction"], what + ".friction", &spec->friction)).ok()) {
-    return status;
-  }
-  if (entry.hasMember("restitution") &&
-      !(status = ReadDouble(entry["restitution"], what + ".restitution", &spec->restitution))
-           .ok()) {
-    return status;
+  // Reads field `key` with `reader` when the entry has it.
+  auto read_field = [&entry, &what](const char* key, auto reader, auto* out) {
+    return entry.hasMember(key) ? reader(entry[key], what + "." + key, out) : Status::Ok();
+  };
+  for (const Status& status :
+       {read_field("name", ReadString, &spec->name), read_field("urdf", ReadString, &spec->urdf),
+        read_field("urdf_path", ReadString, &spec->urdf_path),
+        read_field("is_static", ReadBool, &spec->is_static),
+        read_field("friction", ReadDouble, &spec->friction),
+        read_field("restitution", ReadDouble, &spec->restitution)}) {
+    if (!status.ok()) return status;
   }
   std::vector<double> values;
   if (entry.hasMember("pose")) {
-    if (status = ReadDoubles(entry["pose"], what + ".pose [x, y, z, roll, pitch, yaw]", 6, &values);
+    if (Status status =
+            ReadDoubles(entry["pose"], what + ".pose [x, y, z, roll, pitch, yaw]", 6, &values);
         !status.ok()) {
       return status;
     }
@@ -132,7 +120,8 @@ Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
         QuatFromRollPitchYaw(values[3], values[4], values[5]);
   }
   if (entry.hasMember("twist")) {
-    if (status = ReadDoubles(entry["twist"], what + ".twist [vx, vy, vz, wx, wy, wz]", 6, &values);
+    if (Status status =
+            ReadDoubles(entry["twist"], what + ".twist [vx, vy, vz, wx, wy, wz]", 6, &values);
         !status.ok()) {
       return status;
     }
