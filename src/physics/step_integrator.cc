@@ -183,6 +183,22 @@ void World::IntegrateBodies(double dt) {
     double low = 0.0;
     double gap_low = start_gap;
     if (gap_low <= target_gap) continue;  // already in contact: the solver's business
+    // Most pairs that get here end the step still apart, such as boxes side
+    // by side with a gap below their manifold's reuse error. Asking only
+    // whether they are apart by more than target_gap at the end lets the
+    // pair's cached separating axis answer, a lower bound on the distance,
+    // in a fraction of a full test (seed 000 slide 13).
+    if (samples == 1) {
+      CollideInput input;
+      input.a = &shape_a.geometry;
+      input.world_from_a = pose_at(pair->body_a, a, dt) * shape_a.body_from_shape;
+      input.b = &shape_b.geometry;
+      input.world_from_b = pose_at(pair->body_b, b, dt) * shape_b.body_from_shape;
+      input.contact_distance = target_gap;
+      SeparatingWitness witness = pair->witness;
+      ContactManifold manifold;
+      if (!Collide(input, &witness, &manifold)) continue;
+    }
     double high = -1.0;
     double gap_high = 0.0;
     for (int k = 1; k <= samples; ++k) {
