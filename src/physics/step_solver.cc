@@ -53,12 +53,13 @@ void StoreVelocities(const std::vector<SolverBody>& solver_bodies,
 
 }  // namespace
 
-// A resting report of point i of a pair from its cached impulses; the
+// A resting report of point i of a pair from its cached impulses, with
+// `tangent` the basis of its normal (TangentBasis) that they are in; the
 // solver overwrites what it knows better for the pairs it solved.
-ContactReport World::MakeReport(const ShapePairContact& pair, int i, double dt) const {
+ContactReport World::MakeReport(const ShapePairContact& pair, int i,
+                                const std::array<Vec3, 2>& tangent, double dt) const {
   const ContactPoint& contact = pair.manifold.points[i];
   const CachedImpulse& impulse = pair.previous[i];
-  const std::array<Vec3, 2> tangent = TangentBasis(pair.manifold.normal_world);
   ContactReport report;
   report.body_a = BodyId{pair.body_a, bodies_[pair.body_a].generation};
   report.body_b = BodyId{pair.body_b, bodies_[pair.body_b].generation};
@@ -91,7 +92,8 @@ void World::SolveContacts(double dt) {
   for (const ShapePairContact* pair : pairs) {
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
-    SolverManifold manifold;
+    // Built in place: a manifold with its four points is most of a kilobyte.
+    SolverManifold& manifold = manifolds.emplace_back();
     manifold.body_a = pair->body_a;
     manifold.body_b = pair->body_b;
     manifold.normal_world = pair->manifold.normal_world;
@@ -110,7 +112,6 @@ void World::SolveContacts(double dt) {
       point.normal_impulse = pair->warm_start[i].normal_impulse;
       point.tangent_impulse = pair->warm_start[i].tangent_impulse;
     }
-    manifolds.push_back(manifold);
   }
   solver_.Prepare();
 
@@ -140,9 +141,10 @@ void World::SolveContacts(double dt) {
   if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
     contacts_.clear();
     for (const ShapePairContact* pair : contact_cache_.sleeping()) {
+      const std::array<Vec3, 2> tangent = TangentBasis(pair->manifold.normal_world);
       for (int i = 0; i < pair->manifold.point_count; ++i) {
         if (pair->manifold.points[i].separation > settings_.solver.contact_tolerance) continue;
-        contacts_.push_back(MakeReport(*pair, i, dt));
+        contacts_.push_back(MakeReport(*pair, i, tangent, dt));
       }
     }
     sleeping_reports_version_ = contact_cache_.sleeping_version();
@@ -161,7 +163,8 @@ void World::SolveContacts(double dt) {
       pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse};
       const bool touching = point.separation <= settings_.solver.contact_tolerance;
       if (!touching && point.type != ContactType::kColliding) continue;
-      ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, dt));
+      ContactReport& report =
+          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, dt));
       report.normal_velocity = point.normal_velocity_before;
       report.type = point.type;
       report.normal_impulse = point.collision_impulse + point.normal_impulse;

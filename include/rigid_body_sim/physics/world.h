@@ -2,6 +2,7 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_WORLD_H_
 #define RIGID_BODY_SIM_PHYSICS_WORLD_H_
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -123,7 +124,8 @@ class World {
                       const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void UpdateSleep(double dt);
   void DisableNonFiniteBodies();
-  ContactReport MakeReport(const ShapePairContact& pair, int point, double dt) const;
+  ContactReport MakeReport(const ShapePairContact& pair, int point,
+                          const std::array<Vec3, 2>& tangent, double dt) const;
 
   WorldSettings settings_;
   std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
