@@ -125,7 +125,7 @@ class World {
   void UpdateSleep(double dt);
   void DisableNonFiniteBodies();
   ContactReport MakeReport(const ShapePairContact& pair, int point,
-                          const std::array<Vec3, 2>& tangent, double dt) const;
+                           const std::array<Vec3, 2>& tangent, double dt) const;
 
   WorldSettings settings_;
   std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
