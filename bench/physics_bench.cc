@@ -56,6 +56,10 @@ struct RunResult {
   double integrator_ms = 0.0;
   double solver_point_iterations = 0.0;  // sum over steps of points x iterations
   double solver_rows_ms = 0.0;           // solver time of the steps that had contact points
+  // Steps with contact points to solve, and their wall time in all; sleeping
+  // and free flight make the rest of a run nearly free in either engine.
+  int contact_steps = 0;
+  double contact_steps_ms = 0.0;
   int rows_per_point = 0;
   double final_kinetic_energy = 0.0;  // J
   double final_penetration = 0.0;     // m, deepest point at the last step
@@ -78,6 +82,11 @@ struct Summary {
   long peak_rss_kb = 0;  // largest over the runs
 };
 
+// Wall ms of one step that had contact points to solve.
+double ContactStepMs(const RunResult& result) {
+  return result.contact_steps > 0 ? result.contact_steps_ms / result.contact_steps : 0.0;
+}
+
 RunResult RunScene(const Scene& scene, bool bullet, double window_seconds) {
   std::unique_ptr<Engine> engine = bullet ? MakeBulletEngine(scene) : MakeOurEngine(scene);
   RunResult result;
@@ -96,7 +105,8 @@ RunResult RunScene(const Scene& scene, bool bullet, double window_seconds) {
   for (int step = 0; step < result.steps; ++step) {
     const Clock::time_point start = Clock::now();
     engine->Step();
-    total_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    const double step_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    total_ms += step_ms;
     if (step + 1 == window_steps) result.window_step_ms = total_ms / window_steps;
     const StageTimes stages = engine->LastStageTimes();
     result.broad_phase_ms += stages.broad_phase_ms;
@@ -107,6 +117,8 @@ RunResult RunScene(const Scene& scene, bool bullet, double window_seconds) {
       result.solver_point_iterations +=
           static_cast<double>(stages.solver_points) * stages.velocity_iterations;
       result.solver_rows_ms += stages.solver_ms;
+      ++result.contact_steps;
+      result.contact_steps_ms += step_ms;
     }
     result.peak_penetration = std::max(result.peak_penetration, engine->MaxPenetration());
     if (scene.kind == SceneKind::kBounce && !apex_found) {
@@ -394,9 +406,10 @@ int Main(int argc, char** argv) {
       "iterations); ours: 3 rows per point (normal + 2-D friction), the sweeps each step ran "
       "(up to 20), and its solver stage also holds the collision rounds and 6 position sweeps; "
       "Bullet: 2 rows "
-      "per point, 10 iterations\n");
-  std::printf("%-11s %-6s %9s %9s %9s %9s %13s\n", "scene", "engine", "broad", "narrow", "solver",
-              "integr", "ns/row-iter");
+      "per point, 10 iterations; contact s = simulated time of the steps with contact points to "
+      "solve (the rest is free flight or asleep), ms/contact step = wall time of one of them\n");
+  std::printf("%-11s %-6s %9s %9s %9s %9s %13s %10s %16s\n", "scene", "engine", "broad", "narrow",
+              "solver", "integr", "ns/row-iter", "contact s", "ms/contact step");
   auto row_cost_ns = [](const RunResult& result) {
     const double rows = result.solver_point_iterations * result.rows_per_point;
     return rows > 0.0 ? 1e6 * result.solver_rows_ms / rows : 0.0;
@@ -404,9 +417,10 @@ int Main(int argc, char** argv) {
   for (const auto& [ours, bullet] : rows) {
     for (const Summary* summary : {&ours, &bullet}) {
       const RunResult& result = summary->median;
-      std::printf("%-11s %-6s %9.3f %9.3f %9.3f %9.3f %13.1f\n", summary->scene.c_str(),
-                  summary->engine.c_str(), result.broad_phase_ms, result.narrow_phase_ms,
-                  result.solver_ms, result.integrator_ms, row_cost_ns(result));
+      std::printf("%-11s %-6s %9.3f %9.3f %9.3f %9.3f %13.1f %10.2f %16.3f\n",
+                  summary->scene.c_str(), summary->engine.c_str(), result.broad_phase_ms,
+                  result.narrow_phase_ms, result.solver_ms, result.integrator_ms,
+                  row_cost_ns(result), result.contact_steps * kTimeStep, ContactStepMs(result));
     }
   }
 
@@ -437,7 +451,8 @@ int Main(int argc, char** argv) {
          "ms_per_step_max,steps_per_second,ratio_ours_over_bullet,final_kinetic_energy_j,"
          "final_penetration_m,peak_penetration_m,top_box_drift_m,bounce_apex_m,"
          "bounce_apex_error,incline_slide_m,incline_error,broad_phase_ms,narrow_phase_ms,"
-         "solver_ms,integrator_ms,solver_ns_per_row_iteration,peak_rss_kb\n";
+         "solver_ms,integrator_ms,solver_ns_per_row_iteration,peak_rss_kb,contact_seconds,"
+         "ms_per_contact_step\n";
   std::map<std::string, const Scene*> scene_by_name;
   for (const Scene& scene : scenes) scene_by_name[scene.name] = &scene;
   for (const auto& [ours, bullet] : rows) {
@@ -462,7 +477,8 @@ int Main(int argc, char** argv) {
           << (scene.kind == SceneKind::kIncline ? std::to_string(quality.value) : "") << ','
           << result.broad_phase_ms << ',' << result.narrow_phase_ms << ',' << result.solver_ms
           << ',' << result.integrator_ms << ',' << row_cost_ns(result) << ','
-          << summary->peak_rss_kb << '\n';
+          << summary->peak_rss_kb << ',' << result.contact_steps * kTimeStep << ','
+          << ContactStepMs(result) << '\n';
     }
   }
 
@@ -479,7 +495,7 @@ int Main(int argc, char** argv) {
       // Load and hull of one mesh: the "step" is the whole task (best of the
       // program's repetitions, so min = median = max).
       csv << "hull,ours,1,,1," << total_ms << ',' << total_ms << ',' << total_ms
-          << std::string(16, ',') << '\n';
+          << std::string(18, ',') << '\n';
     }
   }
 
