@@ -105,6 +105,7 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
   // Sized, not cleared: World loads the bodies the contacts reach.
   bodies_.resize(body_count);
   manifolds_.clear();
+  velocities_changed_ = false;
 }
 
 void ContactSolver::Prepare() {
@@ -254,6 +255,7 @@ void ContactSolver::ResolveCollisions() {
   std::vector<std::pair<int, int>> active;
   std::vector<double> normal;
   std::vector<std::array<double, 2>> tangent;
+  velocities_changed_ = false;
   for (int round = 0; round < settings_.max_collision_rounds; ++round) {
     active.clear();
     for (int m = 0; m < static_cast<int>(manifolds_.size()); ++m) {
@@ -261,7 +263,10 @@ void ContactSolver::ResolveCollisions() {
       for (int i = 0; i < manifold.point_count; ++i) {
         const SolverPoint& point = manifold.points[i];
         if (point.separation > settings_.contact_tolerance) continue;
-        if (NormalVelocity(manifold, point) < -epsilon) active.emplace_back(m, i);
+        // Nothing has acted before the first round: Prepare's v_r holds.
+        const double v_r =
+            round == 0 ? point.normal_velocity_before : NormalVelocity(manifold, point);
+        if (v_r < -epsilon) active.emplace_back(m, i);
       }
     }
     // A round of only inelastic points (e = 0) is the resting solve's LCP
@@ -271,6 +276,7 @@ void ContactSolver::ResolveCollisions() {
       return manifolds_[entry.first].restitution > 0.0;
     });
     if (!elastic) return;
+    velocities_changed_ = true;
     if (round == 0) ComputeMasses();
     normal.assign(active.size(), 0.0);
     tangent.assign(active.size(), {0.0, 0.0});
@@ -301,7 +307,9 @@ void ContactSolver::ResolveCollisions() {
 void ContactSolver::RecordStartVelocities() {
   for (SolverManifold& manifold : manifolds_) {
     for (int i = 0; i < manifold.point_count; ++i) {
-      manifold.points[i].normal_velocity_start = NormalVelocity(manifold, manifold.points[i]);
+      SolverPoint& point = manifold.points[i];
+      point.normal_velocity_start =
+          velocities_changed_ ? NormalVelocity(manifold, point) : point.normal_velocity_before;
     }
   }
 }

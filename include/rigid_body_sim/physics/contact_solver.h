@@ -192,6 +192,9 @@ class ContactSolver {
   SolverSettings settings_;
   double time_step_ = 1.0;
   int velocity_sweeps_ = 0;
+  // Whether ResolveCollisions applied impulses, so that v_r may differ from
+  // Prepare's.
+  bool velocities_changed_ = false;
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
   std::vector<RestingRow> rows_;
