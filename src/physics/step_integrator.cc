@@ -152,17 +152,20 @@ void World::IntegrateBodies(double dt) {
     };
     // The gap at time t: the nearest manifold point, capped at a distance
     // beyond anything the step can reach.
-    const double gap_cap = std::max(start_gap, 0.0) + reach + settings_.contact_margin;
-    auto gap_at = [&](double t) {
+    auto input_at = [&](double t, double contact_distance) {
       CollideInput input;
       input.a = &shape_a.geometry;
       input.world_from_a = pose_at(pair->body_a, a, t) * shape_a.body_from_shape;
       input.b = &shape_b.geometry;
       input.world_from_b = pose_at(pair->body_b, b, t) * shape_b.body_from_shape;
-      input.contact_distance = gap_cap;
+      input.contact_distance = contact_distance;
+      return input;
+    };
+    const double gap_cap = std::max(start_gap, 0.0) + reach + settings_.contact_margin;
+    auto gap_at = [&](double t) {
       ContactManifold manifold;
       double gap = gap_cap;
-      if (Collide(input, nullptr, &manifold)) {
+      if (Collide(input_at(t, gap_cap), nullptr, &manifold)) {
         for (int i = 0; i < manifold.point_count; ++i) {
           gap = std::min(gap, manifold.points[i].separation);
         }
@@ -189,15 +192,9 @@ void World::IntegrateBodies(double dt) {
     // pair's cached separating axis answer, a lower bound on the distance,
     // in a fraction of a full test (seed 000 slide 13).
     if (samples == 1) {
-      CollideInput input;
-      input.a = &shape_a.geometry;
-      input.world_from_a = pose_at(pair->body_a, a, dt) * shape_a.body_from_shape;
-      input.b = &shape_b.geometry;
-      input.world_from_b = pose_at(pair->body_b, b, dt) * shape_b.body_from_shape;
-      input.contact_distance = target_gap;
       SeparatingWitness witness = pair->witness;
       ContactManifold manifold;
-      if (!Collide(input, &witness, &manifold)) continue;
+      if (!Collide(input_at(dt, target_gap), &witness, &manifold)) continue;
     }
     double high = -1.0;
     double gap_high = 0.0;
