@@ -43,7 +43,6 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
 void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
                                  const std::function<bool(const ShapePairContact&)>& asleep) {
   touching_.clear();
-  seen_.clear();
   keyed_.clear();
   if (recheck_frozen) {
     for (auto it = frozen_.begin(); it != frozen_.end();) {
@@ -57,21 +56,20 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
   }
   // Every pair was seen this step unless there are more pairs than visits;
   // only then do the unseen ones have to be found and dropped or frozen.
+  // They are among last step's seen_, which holds every pair older than
+  // this step: a walk of that list loads the entries independently of each
+  // other, where a walk of the map would chase its nodes one by one.
   if (pairs_.size() > visited_.size()) {
-    for (auto it = pairs_.begin(); it != pairs_.end();) {
-      if (it->second.last_seen_step == step) {
-        ++it;
-        continue;
-      }
-      auto next = std::next(it);
-      index_.Erase(it->first);
-      if (it->second.previous_count > 0 && asleep(it->second)) {
-        frozen_.insert(pairs_.extract(it));
+    for (ShapePairContact* entry : seen_) {
+      if (entry->last_seen_step == step) continue;
+      const std::uint64_t key = entry->key;
+      index_.Erase(key);
+      if (entry->previous_count > 0 && asleep(*entry)) {
+        frozen_.insert(pairs_.extract(key));
         frozen_changed_ = true;
       } else {
-        pairs_.erase(it);
+        pairs_.erase(key);
       }
-      it = next;
     }
   }
   assert(pairs_.size() == visited_.size());
@@ -118,6 +116,12 @@ void ContactCache::ListSleeping() {
 }
 
 void ContactCache::RemoveBody(std::uint32_t body) {
+  // seen_ goes on listing every pair of pairs_ (MatchAndPrune looks there
+  // for the unseen ones), so the body's pairs leave it before they go.
+  auto of_body = [body](const ShapePairContact* entry) {
+    return entry->body_a == body || entry->body_b == body;
+  };
+  seen_.erase(std::remove_if(seen_.begin(), seen_.end(), of_body), seen_.end());
   for (PairMap* map : {&pairs_, &frozen_}) {
     for (auto it = map->begin(); it != map->end();) {
       if (it->second.body_a == body || it->second.body_b == body) {
@@ -129,7 +133,6 @@ void ContactCache::RemoveBody(std::uint32_t body) {
     }
   }
   touching_.clear();
-  seen_.clear();
   visited_.clear();
   ListSleeping();
 }
