@@ -107,7 +107,7 @@ class ContactCache {
   PairIndex<ShapePairContact> index_;  // key -> entry of pairs_, for Touch
   PairMap frozen_;                     // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
-  std::vector<ShapePairContact*> seen_;  // after MatchAndPrune, every entry of pairs_
+  std::vector<ShapePairContact*> seen_;     // after MatchAndPrune, every entry of pairs_
   std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
   std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of MatchAndPrune
   std::vector<const ShapePairContact*> sleeping_;
