@@ -105,7 +105,6 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
   // Sized, not cleared: World loads the bodies the contacts reach.
   bodies_.resize(body_count);
   manifolds_.clear();
-  velocities_changed_ = false;
 }
 
 void ContactSolver::Prepare() {

@@ -92,7 +92,7 @@ void World::SolveContacts(double dt) {
   for (const ShapePairContact* pair : pairs) {
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
-    // Built in place: a manifold with its four points is most of a kilobyte.
+    // Built in place: a manifold with its four points is 648 bytes.
     SolverManifold& manifold = manifolds.emplace_back();
     manifold.body_a = pair->body_a;
     manifold.body_b = pair->body_b;
