@@ -12,6 +12,7 @@ namespace rigid_body_sim::physics {
 
 void World::UpdateNarrowPhase(double dt) {
   ++step_count_;
+  last_step_profile_.reused_manifolds = 0;
   for (const ProxyPair& pair : broad_phase_.Pairs()) {
     CollideBodies(static_cast<std::uint32_t>(pair.first), static_cast<std::uint32_t>(pair.second),
                   dt);
@@ -148,6 +149,7 @@ void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt)
       const Pose world_from_shape_b = world_from_b * shape_b.body_from_shape;
       if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b,
                         &entry)) {
+        ++last_step_profile_.reused_manifolds;
         continue;
       }
       CollideInput input;

@@ -160,7 +160,8 @@ void World::SolveContacts(double dt) {
     pair.previous_count = manifold.point_count;
     for (int i = 0; i < manifold.point_count; ++i) {
       const SolverPoint& point = manifold.points[i];
-      pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse};
+      pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse,
+                                       pair.manifold.points[i].position_world};
       const bool touching = point.separation <= settings_.solver.contact_tolerance;
       if (!touching && point.type != ContactType::kColliding) continue;
       ContactReport& report =

@@ -24,6 +24,7 @@ struct CachedImpulse {
   FeatureId feature;
   double normal_impulse = 0.0;              // N s
   std::array<double, 2> tangent_impulse{};  // N s, in the manifold's tangent basis
+  Vec3 position_world = Vec3::Zero();       // m, where the point was
 };
 
 // What a manifold between two polyhedra needs to be carried to a nearby
@@ -75,7 +76,8 @@ class ContactCache {
                           std::uint16_t shape_b, std::uint64_t step);
   // Drops the pairs not seen in `step` unless `asleep` says both of their
   // bodies sleep (their contacts still hold, frozen), matches every touching
-  // manifold's points with last step's by feature id, and lists the pairs.
+  // manifold's points with last step's by feature id, or else by position,
+  // and lists the pairs.
   // Frozen pairs are set aside and cost nothing per step; pass
   // `recheck_frozen` when a body woke or left since the last call, so that
   // frozen pairs of bodies no longer asleep go.

@@ -52,6 +52,9 @@ struct StepProfile {
   double integrator_ms = 0.0;     // ms, stage 5
   std::size_t solver_points = 0;  // contact points handed to the solver
   int velocity_sweeps = 0;        // Gauss-Seidel sweeps of the resting solve
+  // Manifolds carried to the new poses (contact_reuse_distance) instead of
+  // clipped, in stage 2.
+  std::size_t reused_manifolds = 0;
 };
 
 class World {
