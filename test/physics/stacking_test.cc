@@ -41,6 +41,41 @@ TEST(StackingTest, TenBoxStackStands) {
   EXPECT_LT(MaxDrift(&world, top, 10.0), 5e-3);
 }
 
+// A column of ten 1 kg boxes spawned at rest, touching: statics says the
+// contact under box i carries the (10 - i) boxes above it, m g each, and
+// nothing moves. New supports start the resting solve from that load, so it
+// holds from the first step, not only once the sweeps have carried the
+// load down the column (from zero the top box falls at centimetres per
+// second for a tenth of a second).
+TEST(StackingTest, ColumnSpawnedAtRestCarriesItsWeightFromTheFirstStep) {
+  World world;
+  const BodyId ground = AddGround(&world, MakeMaterial(0.5, 0.0));
+  const int count = 10;
+  std::vector<BodyId> boxes;
+  for (int i = 0; i < count; ++i) {
+    BoxSpec spec;
+    spec.world_from_body = Translation(0, 0, 0.5 + i);
+    spec.material = MakeMaterial(0.5, 0.0);
+    boxes.push_back(AddBox(&world, spec));
+  }
+  const double g = -world.settings().gravity.z();
+  for (int step = 0; step < 60; ++step) {
+    world.Step();
+    SCOPED_TRACE(::testing::Message() << "step " << step);
+    for (int i = 0; i < count; ++i) {
+      const BodyId below = i == 0 ? ground : boxes[i - 1];
+      double upward = 0.0;  // N, on box i from the body below
+      for (const ContactReport& contact : world.contacts()) {
+        const double up = contact.normal_force * contact.normal_world.z();  // on body A
+        if (contact.body_a == boxes[i] && contact.body_b == below) upward += up;
+        if (contact.body_a == below && contact.body_b == boxes[i]) upward -= up;
+      }
+      EXPECT_NEAR(upward / ((count - i) * 1.0 * g), 1.0, 1e-6) << "box " << i;
+      EXPECT_LT(world.GetLinearVelocity(boxes[i]).norm(), 1e-9) << "box " << i;
+    }
+  }
+}
+
 // 20 rows of unit boxes side by side, 210 in all.
 TEST(StackingTest, TwentyRowPyramidStands) {
   World world;

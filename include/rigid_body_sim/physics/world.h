@@ -127,6 +127,8 @@ class World {
                       const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void UpdateSleep(double dt);
   void DisableNonFiniteBodies();
+  // `pairs` are the touching pairs, one per solver manifold.
+  void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt);
   ContactReport MakeReport(const ShapePairContact& pair, int point,
                            const std::array<Vec3, 2>& tangent, double dt) const;
 
