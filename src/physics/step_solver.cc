@@ -78,14 +78,17 @@ ContactReport World::MakeReport(const ShapePairContact& pair, int i,
 }
 
 // A support that is new this step (a pair that had no contact point last
-// step, and touches at every point now) starts the resting solve from the load it would carry at
-// rest, instead of from zero. Statics of a stack, from the highest body down: a body's load is its
-// weight m g dt plus the loads resting on it; the part its warm supports do not carry already
-// (their impulses n / (n.up)) is shared equally by its new supports, whose points take the normal
-// part n.up of their share; each support passes its load to the body below. Without it,
-// Gauss-Seidel sweeps from zero move a load up a stack by about one level per sweep, so a stack
-// spawned at rest sags and rocks for its first tenth of a second. The estimate is only where the
-// iteration starts: the complementarity conditions, and so the solution, are the same.
+// step, and touches at every point now) starts the resting solve from the
+// load it would carry at rest, instead of from zero. Statics of a stack,
+// from the highest body down: a body's load is its weight m g dt plus the
+// loads resting on it; the part its warm supports do not carry already
+// (their impulses n / (n.up)) is shared equally by its new supports, whose
+// points take the normal part n.up of their share; each support passes its
+// load to the body below. Without it, Gauss-Seidel sweeps from zero move a
+// load up a stack by about one level per sweep, so a stack spawned at rest
+// sags and rocks for its first tenth of a second. The estimate is only
+// where the iteration starts: the complementarity conditions, and so the
+// solution, are the same.
 void World::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt) {
   const double g = settings_.gravity.norm();
   if (g <= 0.0) return;
