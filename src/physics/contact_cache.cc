@@ -93,10 +93,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
     std::array<bool, ContactManifold::kMaxPoints> found{};  // this step's points matched
     for (int i = 0; i < entry->manifold.point_count; ++i) {
       CachedImpulse& warm = entry->warm_start[i];
-      warm = CachedImpulse{entry->manifold.points[i].feature,
-                           0.0,
-                           {0.0, 0.0},
-                           entry->manifold.points[i].position_world};
+      warm = CachedImpulse{entry->manifold.points[i].feature, 0.0, {0.0, 0.0}};
       for (int k = 0; k < entry->previous_count; ++k) {
         if (entry->previous[k].feature == warm.feature) {
           warm = entry->previous[k];
@@ -159,7 +156,7 @@ void ContactCache::RemoveBody(std::uint32_t body) {
   seen_.erase(std::remove_if(seen_.begin(), seen_.end(), of_body), seen_.end());
   for (PairMap* map : {&pairs_, &frozen_}) {
     for (auto it = map->begin(); it != map->end();) {
-      if (it->second.body_a == body || it->second.body_b == body) {
+      if (of_body(&it->second)) {
         if (map == &pairs_) index_.Erase(it->first);
         it = map->erase(it);
       } else {

@@ -24,7 +24,7 @@ struct CachedImpulse {
   FeatureId feature;
   double normal_impulse = 0.0;              // N s
   std::array<double, 2> tangent_impulse{};  // N s, in the manifold's tangent basis
-  Vec3 position_world = Vec3::Zero();       // m, where the point was
+  Vec3 position_world = Vec3::Zero();       // m, where the point was; set in `previous`
 };
 
 // What a manifold between two polyhedra needs to be carried to a nearby
