@@ -44,7 +44,16 @@ class Engine {
 
 constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines
 
-std::unique_ptr<Engine> MakeOurEngine(const Scene& scene);
+// Settings of our engine that a benchmark run may set to other values than
+// the defaults, to measure what they cost and what they buy; 0 keeps the
+// default (physics::WorldSettings).
+struct OurSettingsOverrides {
+  int velocity_iterations = 0;  // PGS sweeps per step, at most, >= 1
+  double time_to_sleep = 0.0;   // s an island must stay slow before it sleeps, > 0
+};
+
+std::unique_ptr<Engine> MakeOurEngine(const Scene& scene,
+                                      const OurSettingsOverrides& overrides = {});
 std::unique_ptr<Engine> MakeBulletEngine(const Scene& scene);
 
 }  // namespace rigid_body_sim::bench

@@ -1,4 +1,5 @@
-// The scenes in rigid_body_sim::physics::World with its default settings.
+// The scenes in rigid_body_sim::physics::World with its default settings,
+// or with the few that OurSettingsOverrides sets.
 #include <algorithm>
 #include <cassert>
 #include <memory>
@@ -23,9 +24,14 @@ physics::Material ToMaterial(const BenchMaterial& material) {
 
 class OurEngine : public Engine {
  public:
-  explicit OurEngine(const Scene& scene) {
+  OurEngine(const Scene& scene, const OurSettingsOverrides& overrides) {
     physics::WorldSettings settings;
     settings.time_step = kTimeStep;
+    if (overrides.velocity_iterations > 0) {
+      settings.solver.velocity_iterations = overrides.velocity_iterations;
+    }
+    if (overrides.time_to_sleep > 0.0) settings.sleep.time_to_sleep = overrides.time_to_sleep;
+    assert(physics::ValidateWorldSettings(settings).ok());
     world_ = std::make_unique<physics::World>(settings);
 
     physics::BodyDef ground;
@@ -113,8 +119,8 @@ class OurEngine : public Engine {
 
 }  // namespace
 
-std::unique_ptr<Engine> MakeOurEngine(const Scene& scene) {
-  return std::make_unique<OurEngine>(scene);
+std::unique_ptr<Engine> MakeOurEngine(const Scene& scene, const OurSettingsOverrides& overrides) {
+  return std::make_unique<OurEngine>(scene, overrides);
 }
 
 }  // namespace rigid_body_sim::bench

@@ -10,9 +10,12 @@
 // Usage: physics_bench [--csv PATH] [--runs N] [--large-runs N] [--scale S]
 //                      [--only a,b]
 //                      [--hull-bench PATH]
+//                      [--velocity-iterations N] [--time-to-sleep S]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
-//   their number of runs.
+//   their number of runs. --velocity-iterations and --time-to-sleep (s) run
+//   our engine with those solver and sleep settings instead of the
+//   defaults, to measure what a setting costs or buys; the header says so.
 
 #include <sys/resource.h>
 #include <sys/types.h>
@@ -90,8 +93,16 @@ double ContactStepMs(const RunResult& result) {
   return result.contact_steps > 0 ? result.contact_steps_ms / result.contact_steps : 0.0;
 }
 
-RunResult RunScene(const Scene& scene, bool bullet, double window_seconds) {
-  std::unique_ptr<Engine> engine = bullet ? MakeBulletEngine(scene) : MakeOurEngine(scene);
+// How every run of a benchmark is made.
+struct RunSettings {
+  double window_seconds = 10.0;  // s; the stage profile's window (RunResult)
+  OurSettingsOverrides overrides;
+};
+
+RunResult RunScene(const Scene& scene, bool bullet, const RunSettings& settings) {
+  std::unique_ptr<Engine> engine =
+      bullet ? MakeBulletEngine(scene) : MakeOurEngine(scene, settings.overrides);
+  const double window_seconds = settings.window_seconds;
   RunResult result;
   result.steps = static_cast<int>(std::lround(scene.seconds / kTimeStep));
   result.rows_per_point = engine->RowsPerPoint();
@@ -171,7 +182,7 @@ RunResult RunScene(const Scene& scene, bool bullet, double window_seconds) {
 }
 
 // Runs one scene in a child process; returns false when the child failed.
-bool RunInChild(const Scene& scene, bool bullet, double window_seconds, RunResult* result) {
+bool RunInChild(const Scene& scene, bool bullet, const RunSettings& settings, RunResult* result) {
   int fds[2];
   if (pipe(fds) != 0) return false;
   std::fflush(stdout);
@@ -179,7 +190,7 @@ bool RunInChild(const Scene& scene, bool bullet, double window_seconds, RunResul
   if (pid < 0) return false;
   if (pid == 0) {
     close(fds[0]);
-    const RunResult child_result = RunScene(scene, bullet, window_seconds);
+    const RunResult child_result = RunScene(scene, bullet, settings);
     const ssize_t written = write(fds[1], &child_result, sizeof(child_result));
     _exit(written == static_cast<ssize_t>(sizeof(child_result)) ? 0 : 1);
   }
@@ -221,7 +232,7 @@ Scene JitterScene(const Scene& scene, int seed) {
   return jittered;
 }
 
-Summary Measure(const Scene& scene, bool bullet, int runs, double window_seconds) {
+Summary Measure(const Scene& scene, bool bullet, int runs, const RunSettings& settings) {
   Summary summary;
   summary.scene = scene.name;
   summary.engine = bullet ? "bullet" : "ours";
@@ -230,7 +241,7 @@ Summary Measure(const Scene& scene, bool bullet, int runs, double window_seconds
   std::vector<RunResult> results;
   for (int run = 0; run < runs; ++run) {
     RunResult result;
-    if (!RunInChild(JitterScene(scene, run), bullet, window_seconds, &result)) {
+    if (!RunInChild(JitterScene(scene, run), bullet, settings, &result)) {
       std::fprintf(stderr, "%s/%s: run %d failed\n", scene.name.c_str(), summary.engine.c_str(),
                    run);
       continue;
@@ -321,6 +332,8 @@ struct Options {
   double scale = 1.0;
   std::vector<std::string> only;
   std::string hull_bench;
+  OurSettingsOverrides overrides;
+  std::string error;  // set when an option's value is refused
 };
 
 Options ParseOptions(int argc, char** argv) {
@@ -342,6 +355,22 @@ Options ParseOptions(int argc, char** argv) {
       while (std::getline(list, name, ',')) options.only.push_back(name);
     } else if (key == "--hull-bench") {
       options.hull_bench = value;
+    } else if (key == "--velocity-iterations") {
+      char* end = nullptr;
+      const long iterations = std::strtol(value.c_str(), &end, 10);
+      if (*end != '\0' || iterations < 1 || iterations > 10000) {
+        options.error = "--velocity-iterations wants a whole number in [1, 10000], got " + value;
+      } else {
+        options.overrides.velocity_iterations = static_cast<int>(iterations);
+      }
+    } else if (key == "--time-to-sleep") {
+      char* end = nullptr;
+      const double seconds = std::strtod(value.c_str(), &end);
+      if (*end != '\0' || !(seconds > 0.0) || !std::isfinite(seconds)) {
+        options.error = "--time-to-sleep wants a time in s, > 0, got " + value;
+      } else {
+        options.overrides.time_to_sleep = seconds;
+      }
     } else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
     }
@@ -361,6 +390,10 @@ std::string RunCommand(const std::string& command) {
 
 int Main(int argc, char** argv) {
   const Options options = ParseOptions(argc, argv);
+  if (!options.error.empty()) {
+    std::fprintf(stderr, "physics_bench: %s\n", options.error.c_str());
+    return 2;
+  }
   // Simulated seconds: 10 s as the scene list says, except the two largest
   // scenes, which --scale shortens so a full run stays within minutes.
   std::vector<Scene> scenes = {
@@ -385,6 +418,14 @@ int Main(int argc, char** argv) {
         "%d run(s)\n\n",
         window_seconds, options.large_runs);
   }
+  if (options.overrides.velocity_iterations > 0) {
+    std::printf("ours: velocity_iterations = %d instead of the default\n",
+                options.overrides.velocity_iterations);
+  }
+  if (options.overrides.time_to_sleep > 0.0) {
+    std::printf("ours: time_to_sleep = %g s instead of the default\n",
+                options.overrides.time_to_sleep);
+  }
   std::printf(
       "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "
       "[min, max], each run in its own process\n",
@@ -402,8 +443,9 @@ int Main(int argc, char** argv) {
   std::vector<std::pair<Summary, Summary>> rows;  // (ours, bullet) per scene
   for (const Scene& scene : scenes) {
     const int runs = IsLarge(scene) ? options.large_runs : options.runs;
-    const Summary ours = Measure(scene, false, runs, window_seconds);
-    const Summary bullet = Measure(scene, true, runs, window_seconds);
+    const RunSettings run_settings{window_seconds, options.overrides};
+    const Summary ours = Measure(scene, false, runs, run_settings);
+    const Summary bullet = Measure(scene, true, runs, run_settings);
     for (const Summary* summary : {&ours, &bullet}) {
       const Quality quality = SceneQuality(scene, summary->median);
       char ratio[32] = "";
