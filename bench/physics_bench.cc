@@ -6,6 +6,9 @@
 //
 // Each run is a child process (fork), so its peak resident memory is its
 // own (wait4's ru_maxrss) and no run inherits another's allocator state.
+// The two engines' runs alternate, and the ratio is the median of the
+// ratios of runs made back to back, as the machines are shared and their
+// load drifts over minutes.
 //
 // Usage: physics_bench [--csv PATH] [--runs N] [--large-runs N] [--scale S]
 //                      [--only a,b]
@@ -86,6 +89,9 @@ struct Summary {
   double ms_min = 0.0;
   double ms_max = 0.0;
   long peak_rss_kb = 0;  // largest over the runs
+  // Ours only: the median over the runs of ours/Bullet ms per step, each
+  // pair run back to back (MeasureBoth); 0 when not measured.
+  double ratio_to_bullet = 0.0;
 };
 
 // Wall ms of one step that had contact points to solve.
@@ -232,22 +238,19 @@ Scene JitterScene(const Scene& scene, int seed) {
   return jittered;
 }
 
-Summary Measure(const Scene& scene, bool bullet, int runs, const RunSettings& settings) {
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// Sums up one engine's runs of a scene (none when all failed).
+Summary Summarize(const Scene& scene, bool bullet, std::vector<RunResult> results) {
   Summary summary;
   summary.scene = scene.name;
   summary.engine = bullet ? "bullet" : "ours";
   summary.bodies = static_cast<int>(scene.bodies.size());
   summary.seconds = scene.seconds;
-  std::vector<RunResult> results;
-  for (int run = 0; run < runs; ++run) {
-    RunResult result;
-    if (!RunInChild(JitterScene(scene, run), bullet, settings, &result)) {
-      std::fprintf(stderr, "%s/%s: run %d failed\n", scene.name.c_str(), summary.engine.c_str(),
-                   run);
-      continue;
-    }
-    results.push_back(result);
-  }
   if (results.empty()) return summary;
   // Each quality figure is the median over the runs on its own, so that it
   // does not depend on which run the machine happened to run fastest; the
@@ -262,8 +265,7 @@ Summary Measure(const Scene& scene, bool bullet, int runs, const RunSettings& se
   for (double RunResult::*figure : kQualityFigures) {
     std::vector<double> values;
     for (const RunResult& result : results) values.push_back(result.*figure);
-    std::sort(values.begin(), values.end());
-    medians.push_back(values[values.size() / 2]);
+    medians.push_back(Median(std::move(values)));
   }
   std::sort(results.begin(), results.end(),
             [](const RunResult& a, const RunResult& b) { return a.step_ms < b.step_ms; });
@@ -278,6 +280,33 @@ Summary Measure(const Scene& scene, bool bullet, int runs, const RunSettings& se
     summary.peak_rss_kb = std::max(summary.peak_rss_kb, result.peak_rss_kb);
   }
   return summary;
+}
+
+// Runs a scene in both engines, run k of ours right before run k of Bullet
+// (the same jitter seed), so that a change in the shared machine's load
+// between runs reaches both engines alike. The ratio is the median over the
+// runs of each pair's ours/Bullet ms per step.
+std::pair<Summary, Summary> MeasureBoth(const Scene& scene, int runs, const RunSettings& settings) {
+  std::vector<RunResult> ours_results;
+  std::vector<RunResult> bullet_results;
+  std::vector<double> ratios;
+  for (int run = 0; run < runs; ++run) {
+    const Scene jittered = JitterScene(scene, run);
+    RunResult ours;
+    RunResult bullet;
+    const bool ours_ok = RunInChild(jittered, false, settings, &ours);
+    const bool bullet_ok = RunInChild(jittered, true, settings, &bullet);
+    if (!ours_ok) std::fprintf(stderr, "%s/ours: run %d failed\n", scene.name.c_str(), run);
+    if (!bullet_ok) std::fprintf(stderr, "%s/bullet: run %d failed\n", scene.name.c_str(), run);
+    if (ours_ok) ours_results.push_back(ours);
+    if (bullet_ok) bullet_results.push_back(bullet);
+    if (ours_ok && bullet_ok && bullet.step_ms > 0.0)
+      ratios.push_back(ours.step_ms / bullet.step_ms);
+  }
+  std::pair<Summary, Summary> summaries(Summarize(scene, false, std::move(ours_results)),
+                                        Summarize(scene, true, std::move(bullet_results)));
+  summaries.first.ratio_to_bullet = Median(std::move(ratios));
+  return summaries;
 }
 
 // The scene's quality figure as text and as a number for the CSV.
@@ -428,7 +457,8 @@ int Main(int argc, char** argv) {
   }
   std::printf(
       "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "
-      "[min, max], each run in its own process\n",
+      "[min, max], each run in its own process, run k of ours right before run k of Bullet; "
+      "ours/blt: the median of the runs' ratios\n",
       options.runs);
   std::printf(
       "quality figures (KE, pen, drift, apex, slide): each the median over the runs (run 0 as "
@@ -444,13 +474,12 @@ int Main(int argc, char** argv) {
   for (const Scene& scene : scenes) {
     const int runs = IsLarge(scene) ? options.large_runs : options.runs;
     const RunSettings run_settings{window_seconds, options.overrides};
-    const Summary ours = Measure(scene, false, runs, run_settings);
-    const Summary bullet = Measure(scene, true, runs, run_settings);
+    const auto [ours, bullet] = MeasureBoth(scene, runs, run_settings);
     for (const Summary* summary : {&ours, &bullet}) {
       const Quality quality = SceneQuality(scene, summary->median);
       char ratio[32] = "";
-      if (summary == &ours && bullet.ms_median > 0.0) {
-        std::snprintf(ratio, sizeof(ratio), "%.2f", ours.ms_median / bullet.ms_median);
+      if (summary == &ours && ours.ratio_to_bullet > 0.0) {
+        std::snprintf(ratio, sizeof(ratio), "%.2f", ours.ratio_to_bullet);
       }
       std::printf(
           "%-11s %-6s %6d %6.2f %8.3f [%6.3f,%6.3f] %9.0f %9s %10.3g %11.2f %15.2f %7.1f  %s\n",
@@ -542,8 +571,7 @@ int Main(int argc, char** argv) {
       const Scene& scene = *scene_by_name[summary->scene];
       const RunResult& result = summary->median;
       const Quality quality = SceneQuality(scene, result);
-      const double ratio =
-          summary == &ours && bullet.ms_median > 0.0 ? ours.ms_median / bullet.ms_median : 0.0;
+      const double ratio = summary == &ours ? ours.ratio_to_bullet : 0.0;
       csv << summary->scene << ',' << summary->engine << ',' << summary->bodies << ','
           << summary->seconds << ',' << result.steps << ',' << summary->ms_median << ','
           << summary->ms_min << ',' << summary->ms_max << ',' << 1e3 / summary->ms_median << ','
