@@ -300,8 +300,9 @@ std::pair<Summary, Summary> MeasureBoth(const Scene& scene, int runs, const RunS
     if (!bullet_ok) std::fprintf(stderr, "%s/bullet: run %d failed\n", scene.name.c_str(), run);
     if (ours_ok) ours_results.push_back(ours);
     if (bullet_ok) bullet_results.push_back(bullet);
-    if (ours_ok && bullet_ok && bullet.step_ms > 0.0)
+    if (ours_ok && bullet_ok && bullet.step_ms > 0.0) {
       ratios.push_back(ours.step_ms / bullet.step_ms);
+    }
   }
   std::pair<Summary, Summary> summaries(Summarize(scene, false, std::move(ours_results)),
                                         Summarize(scene, true, std::move(bullet_results)));
