@@ -22,7 +22,9 @@ void IntegratePositions(double dt, const std::vector<std::uint32_t>& moving,
                         std::vector<Body>* bodies);
 
 // Orientation after dt of torque-free motion with world angular momentum L
-// held constant: RK4 on q' = 1/2 (0, omega(q)) q, omega(q) = R(q) I^-1 R(q)^T L.
+// held constant: RK4 on q' = 1/2 (0, omega(q)) q, omega(q) = R(q) I^-1 R(q)^T L;
+// exactly, as a rotation by the constant omega = I^-1 L, when the three
+// principal moments are equal.
 Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_principal_moments,
                       const Vec3& angular_momentum_world, double dt);
 
