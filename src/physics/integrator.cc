@@ -36,6 +36,14 @@ Eigen::Vector4d QuaternionRate(const Eigen::Vector4d& wxyz, const Vec3& inverse_
   return 0.5 * Eigen::Vector4d(rate.w(), rate.x(), rate.y(), rate.z());
 }
 
+// q turned by the rotation vector theta (|theta| about theta / |theta|),
+// exactly: exp(theta / 2) q.
+Quat Rotated(const Quat& q, const Vec3& rotation_vector) {
+  const double angle = rotation_vector.norm();
+  if (angle == 0.0) return q;
+  return (Quat(Eigen::AngleAxisd(angle, rotation_vector / angle)) * q).normalized();
+}
+
 }  // namespace
 
 Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_principal_moments,
@@ -47,10 +55,7 @@ Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_prin
   if (inverse_principal_moments.x() == inverse_principal_moments.y() &&
       inverse_principal_moments.y() == inverse_principal_moments.z()) {
     const Vec3 omega_world = inverse_principal_moments.x() * angular_momentum_world;
-    const double speed = omega_world.norm();
-    if (speed == 0.0) return world_from_principal;
-    return (Quat(Eigen::AngleAxisd(speed * dt, omega_world / speed)) * world_from_principal)
-        .normalized();
+    return Rotated(world_from_principal, dt * omega_world);
   }
   const Eigen::Vector4d q0(world_from_principal.w(), world_from_principal.x(),
                            world_from_principal.y(), world_from_principal.z());
@@ -93,11 +98,7 @@ void IntegratePositions(double dt, const std::vector<std::uint32_t>& moving,
     }
     if (!body.pseudo_angular_velocity.isZero(0.0)) {
       // The split-impulse rotation, a small angle applied as an exact rotation.
-      const Vec3 rotation_vector = dt * body.pseudo_angular_velocity;
-      body.orientation =
-          (Quat(Eigen::AngleAxisd(rotation_vector.norm(), rotation_vector.normalized())) *
-           body.orientation)
-              .normalized();
+      body.orientation = Rotated(body.orientation, dt * body.pseudo_angular_velocity);
     }
     body.start_linear_velocity = body.linear_velocity;
     body.pseudo_linear_velocity.setZero();
