@@ -48,8 +48,9 @@ constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines
 // the defaults, to measure what they cost and what they buy; 0 keeps the
 // default (physics::WorldSettings).
 struct OurSettingsOverrides {
-  int velocity_iterations = 0;  // PGS sweeps per step, at most, >= 1
-  double time_to_sleep = 0.0;   // s an island must stay slow before it sleeps, > 0
+  int velocity_iterations = 0;       // PGS sweeps per step, at most, >= 1
+  double time_to_sleep = 0.0;        // s an island must stay slow before it sleeps, > 0
+  double velocity_tolerance = -1.0;  // m/s, the sweeps' early stop, >= 0 (< 0: the default)
 };
 
 std::unique_ptr<Engine> MakeOurEngine(const Scene& scene,

@@ -31,6 +31,9 @@ class OurEngine : public Engine {
       settings.solver.velocity_iterations = overrides.velocity_iterations;
     }
     if (overrides.time_to_sleep > 0.0) settings.sleep.time_to_sleep = overrides.time_to_sleep;
+    if (overrides.velocity_tolerance >= 0.0) {
+      settings.solver.velocity_tolerance = overrides.velocity_tolerance;
+    }
     assert(physics::ValidateWorldSettings(settings).ok());
     world_ = std::make_unique<physics::World>(settings);
 

@@ -401,6 +401,14 @@ Options ParseOptions(int argc, char** argv) {
       } else {
         options.overrides.time_to_sleep = seconds;
       }
+    } else if (key == "--velocity-tolerance") {
+      char* end = nullptr;
+      const double tolerance = std::strtod(value.c_str(), &end);
+      if (*end != '\0' || !(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+        options.error = "--velocity-tolerance wants a speed in m/s, >= 0, got " + value;
+      } else {
+        options.overrides.velocity_tolerance = tolerance;
+      }
     } else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
     }
@@ -455,6 +463,10 @@ int Main(int argc, char** argv) {
   if (options.overrides.time_to_sleep > 0.0) {
     std::printf("ours: time_to_sleep = %g s instead of the default\n",
                 options.overrides.time_to_sleep);
+  }
+  if (options.overrides.velocity_tolerance >= 0.0) {
+    std::printf("ours: velocity_tolerance = %g m/s instead of the default\n",
+                options.overrides.velocity_tolerance);
   }
   std::printf(
       "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "

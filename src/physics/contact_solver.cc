@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -385,91 +386,261 @@ void ContactSolver::BuildRestingRows() {
   }
 }
 
+namespace {
+
+// A run partners with one of at most this many runs after it that are not
+// scheduled yet.
+constexpr int kPartnerWindow = 4;
+// Marks a body the solve cannot move (static or asleep): rows that share
+// only such bodies are independent.
+constexpr std::uint32_t kFixedBody = std::numeric_limits<std::uint32_t>::max();
+
+// The velocities of the two bodies of one run of rows, held in locals while
+// the run's rows update them, so that one row's result reaches the next in
+// registers instead of through memory.
+struct RunVelocities {
+  Vec3 linear_a;
+  Vec3 angular_a;
+  Vec3 linear_b;
+  Vec3 angular_b;
+};
+
+RunVelocities LoadVelocities(const SolverBody& a, const SolverBody& b) {
+  return {a.linear_velocity, a.angular_velocity, b.linear_velocity, b.angular_velocity};
+}
+
+void StoreVelocities(const RunVelocities& velocities, SolverBody* a, SolverBody* b) {
+  a->linear_velocity = velocities.linear_a;
+  a->angular_velocity = velocities.angular_a;
+  b->linear_velocity = velocities.linear_b;
+  b->angular_velocity = velocities.angular_b;
+}
+
+RunVelocities LoadPseudoVelocities(const SolverBody& a, const SolverBody& b) {
+  return {a.pseudo_linear_velocity, a.pseudo_angular_velocity, b.pseudo_linear_velocity,
+          b.pseudo_angular_velocity};
+}
+
+void StorePseudoVelocities(const RunVelocities& velocities, SolverBody* a, SolverBody* b) {
+  a->pseudo_linear_velocity = velocities.linear_a;
+  a->pseudo_angular_velocity = velocities.angular_a;
+  b->pseudo_linear_velocity = velocities.linear_b;
+  b->pseudo_angular_velocity = velocities.angular_b;
+}
+
 // Adds the impulse (normal, tangent 0, tangent 1) components of a row to its
 // bodies: dv = +-J / M, dw = +-sum_k j_k I^-1 (r x d_k) with the responses
 // I^-1 (r x d_k) made once per step, so a sweep does no 3x3 product.
-void ContactSolver::ApplyRowImpulse(const RestingRow& row, const Vec3& components) {
-  SolverBody& a = bodies_[row.body_a];
-  SolverBody& b = bodies_[row.body_b];
+void AddRowImpulse(const RestingRow& row, const Vec3& components, RunVelocities* velocities) {
   const Vec3 impulse_world =
       components[0] * row.normal + components[1] * row.tangent[0] + components[2] * row.tangent[1];
-  a.linear_velocity += row.inverse_mass_a * impulse_world;
-  a.angular_velocity += components[0] * row.angular_a[0] + components[1] * row.angular_a[1] +
-                        components[2] * row.angular_a[2];
-  b.linear_velocity -= row.inverse_mass_b * impulse_world;
-  b.angular_velocity -= components[0] * row.angular_b[0] + components[1] * row.angular_b[1] +
-                        components[2] * row.angular_b[2];
+  velocities->linear_a += row.inverse_mass_a * impulse_world;
+  velocities->angular_a += components[0] * row.angular_a[0] + components[1] * row.angular_a[1] +
+                           components[2] * row.angular_a[2];
+  velocities->linear_b -= row.inverse_mass_b * impulse_world;
+  velocities->angular_b -= components[0] * row.angular_b[0] + components[1] * row.angular_b[1] +
+                           components[2] * row.angular_b[2];
+}
+
+// One projected Gauss-Seidel update of a point: the relative velocity is
+// read once; the friction impulse is projected onto the disc
+// |f_t| <= mu f_n, the normal velocity is corrected by what that change
+// adds (normal_coupling, n.K t = t.K n), the normal impulse is projected
+// onto f >= 0, and the sum of the three changes is applied once. Returns
+// |v - v_previous sweep|^2, m^2/s^2.
+double UpdateRestingRow(RestingRow* row, RunVelocities* velocities) {
+  const Vec3 v = velocities->linear_a + velocities->angular_a.cross(row->r_a) -
+                 velocities->linear_b - velocities->angular_b.cross(row->r_b);
+  const double change_squared = (v - row->last_velocity).squaredNorm();
+  row->last_velocity = v;
+  Vec3 change = Vec3::Zero();  // normal, tangent 0, tangent 1
+  double normal_velocity = row->normal.dot(v);
+  if (row->friction > 0.0) {
+    const std::array<double, 2> old_tangent = row->tangent_impulse;
+    for (int k = 0; k < 2; ++k) {
+      row->tangent_impulse[k] -= row->tangent_mass * row->tangent[k].dot(v);
+    }
+    ClampToDisc(row->friction * row->normal_impulse, &row->tangent_impulse);
+    for (int k = 0; k < 2; ++k) {
+      change[k + 1] = row->tangent_impulse[k] - old_tangent[k];
+      normal_velocity += row->normal_coupling[k] * change[k + 1];
+    }
+  }
+  const double old_normal = row->normal_impulse;
+  row->normal_impulse =
+      std::max(0.0, old_normal + row->normal_mass * (row->target - normal_velocity));
+  change[0] = row->normal_impulse - old_normal;
+  AddRowImpulse(*row, change, velocities);
+  return change_squared;
+}
+
+// One update of a point's split impulse: the pseudo velocity along the
+// normal is driven to position_correction depth / dt, with a non-negative
+// impulse.
+void UpdatePseudoRow(double position_correction, double inverse_dt, RestingRow* row,
+                     RunVelocities* velocities) {
+  if (row->depth <= 0.0) return;
+  const double target = position_correction * row->depth * inverse_dt;
+  const double v_r = row->normal.dot(velocities->linear_a + velocities->angular_a.cross(row->r_a) -
+                                     velocities->linear_b - velocities->angular_b.cross(row->r_b));
+  const double old_impulse = row->pseudo_impulse;
+  row->pseudo_impulse = std::max(0.0, old_impulse + row->normal_mass * (target - v_r));
+  const double change = row->pseudo_impulse - old_impulse;
+  velocities->linear_a += (row->inverse_mass_a * change) * row->normal;
+  velocities->angular_a += change * row->angular_a[0];
+  velocities->linear_b -= (row->inverse_mass_b * change) * row->normal;
+  velocities->angular_b -= change * row->angular_b[0];
+}
+
+// The update of a sweep over the real velocities (UpdateRestingRow) or, with
+// kPseudo, the split impulse's (UpdatePseudoRow, which returns 0).
+template <bool kPseudo>
+double UpdateRow(double position_correction, double inverse_dt, RestingRow* row,
+                 RunVelocities* velocities) {
+  if constexpr (kPseudo) {
+    UpdatePseudoRow(position_correction, inverse_dt, row, velocities);
+    return 0.0;
+  } else {
+    return UpdateRestingRow(row, velocities);
+  }
+}
+
+}  // namespace
+
+// One sweep over the schedule, the two runs of a task alternately: the
+// resting rows' Gauss-Seidel update on the real velocities, or with kPseudo
+// the split impulse's on the pseudo velocities. Returns the largest
+// |v - v_previous sweep|^2 of a point (0 with kPseudo), m^2/s^2. Flattened:
+// with any update left a call, a run's velocities stay in memory and the
+// sweep takes 30 % longer.
+template <bool kPseudo>
+[[gnu::flatten]] double ContactSolver::SweepSchedule() {
+  const double correction = settings_.position_correction;
+  const double inverse_dt = 1.0 / time_step_;
+  double largest_change_squared = 0.0;
+  for (const SweepTask& task : schedule_) {
+    const bool paired = task.second_begin != task.second_end;
+    SolverBody& first_a = bodies_[rows_[task.first_begin].body_a];
+    SolverBody& first_b = bodies_[rows_[task.first_begin].body_b];
+    // An unpaired task loads its first run's bodies as the second run's too;
+    // the empty second run never updates or stores them.
+    const std::uint32_t second_row = paired ? task.second_begin : task.first_begin;
+    SolverBody& second_a = bodies_[rows_[second_row].body_a];
+    SolverBody& second_b = bodies_[rows_[second_row].body_b];
+    RunVelocities first =
+        kPseudo ? LoadPseudoVelocities(first_a, first_b) : LoadVelocities(first_a, first_b);
+    RunVelocities second =
+        kPseudo ? LoadPseudoVelocities(second_a, second_b) : LoadVelocities(second_a, second_b);
+    std::uint32_t r = task.first_begin;
+    std::uint32_t s = task.second_begin;
+    while (r < task.first_end || s < task.second_end) {
+      if (r < task.first_end) {
+        largest_change_squared =
+            std::max(largest_change_squared,
+                     UpdateRow<kPseudo>(correction, inverse_dt, &rows_[r++], &first));
+      }
+      if (s < task.second_end) {
+        largest_change_squared =
+            std::max(largest_change_squared,
+                     UpdateRow<kPseudo>(correction, inverse_dt, &rows_[s++], &second));
+      }
+    }
+    if constexpr (kPseudo) {
+      if (paired) StorePseudoVelocities(second, &second_a, &second_b);
+      StorePseudoVelocities(first, &first_a, &first_b);
+    } else {
+      if (paired) StoreVelocities(second, &second_a, &second_b);
+      StoreVelocities(first, &first_a, &first_b);
+    }
+  }
+  return largest_change_squared;
+}
+
+// Gauss-Seidel updates of rows that share no body the solve can move commute
+// exactly, in floating point too: each reads and writes only its own
+// bodies' velocities. So a run of rows (one body pair's) may move forward
+// past runs it shares no moving body with, to be updated side by side with
+// the run it then follows. A sweep in this order gives bit for bit the
+// sweep in manifold order, while the processor overlaps two independent
+// chains of updates: a sweep is bound by the latency of one update feeding
+// the next, not by memory or arithmetic. Greedy, in manifold order: each
+// run not yet scheduled takes the first of the next kPartnerWindow such runs
+// that shares no moving body with it nor with the runs it would pass.
+void ContactSolver::ScheduleRuns() {
+  struct Run {
+    std::uint32_t begin;
+    std::uint32_t end;
+    std::array<std::uint32_t, 2> moving;  // kFixedBody for a body that does not move
+    bool scheduled;
+  };
+  auto moving = [&](std::uint32_t index) {
+    const SolverBody& body = bodies_[index];
+    const bool moves =
+        body.inverse_mass != 0.0 || (body.inverse_inertia_world.array() != 0.0).any();
+    return moves ? index : kFixedBody;
+  };
+  std::vector<Run> runs;
+  for (std::uint32_t r = 0; r < rows_.size();) {
+    const std::uint32_t begin = r;
+    const std::uint32_t a = rows_[r].body_a;
+    const std::uint32_t b = rows_[r].body_b;
+    while (r < rows_.size() && rows_[r].body_a == a && rows_[r].body_b == b) ++r;
+    runs.push_back({begin, r, {moving(a), moving(b)}, false});
+  }
+  schedule_.clear();
+  std::vector<std::uint32_t> blocked;
+  auto is_blocked = [&](const Run& run) {
+    for (const std::uint32_t body : run.moving) {
+      if (body != kFixedBody && std::find(blocked.begin(), blocked.end(), body) != blocked.end()) {
+        return true;
+      }
+    }
+    return false;
+  };
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (runs[i].scheduled) continue;
+    runs[i].scheduled = true;
+    SweepTask& task = schedule_.emplace_back();
+    task.first_begin = runs[i].begin;
+    task.first_end = runs[i].end;
+    task.second_begin = task.second_end = runs[i].end;
+    blocked.assign(runs[i].moving.begin(), runs[i].moving.end());
+    const int window = settings_.interleave_independent_runs ? kPartnerWindow : 0;
+    int looked = 0;
+    for (std::size_t j = i + 1; j < runs.size() && looked < window; ++j) {
+      if (runs[j].scheduled) continue;
+      ++looked;
+      if (!is_blocked(runs[j])) {
+        runs[j].scheduled = true;
+        task.second_begin = runs[j].begin;
+        task.second_end = runs[j].end;
+        break;
+      }
+      blocked.insert(blocked.end(), runs[j].moving.begin(), runs[j].moving.end());
+    }
+  }
 }
 
 void ContactSolver::SolveRestingContacts() {
   BuildRestingRows();
+  ScheduleRuns();
   for (const RestingRow& row : rows_) {
-    ApplyRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]));
+    SolverBody& a = bodies_[row.body_a];
+    SolverBody& b = bodies_[row.body_b];
+    RunVelocities velocities = LoadVelocities(a, b);
+    AddRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]),
+                  &velocities);
+    StoreVelocities(velocities, &a, &b);
   }
 
-  // Projected Gauss-Seidel, one block per point: the relative velocity is
-  // read once; the friction impulse is projected onto the disc
-  // |f_t| <= mu f_n, the normal velocity is corrected by what that change
-  // adds (normal_coupling, n.K t = t.K n), the normal impulse is projected
-  // onto f >= 0, and the sum of the three changes is applied once. Sweeps
-  // stop early once no point's relative velocity changed by more than
-  // velocity_tolerance since the previous sweep: the motion has converged,
-  // even where the impulses of redundant points (four corners where three
-  // would carry the load) still trade load between them.
-  //
-  // The rows of one body pair (a manifold's are adjacent) run on local
-  // copies of the two bodies' velocities, stored back after the pair's last
-  // row: one row's result reaches the next in registers, not through memory.
-  // (Plain Vec3 locals: GCC keeps a struct of all four in memory, 10 % slower.)
+  // Projected Gauss-Seidel, one block per point (UpdateRestingRow), in the
+  // schedule's order. Sweeps stop early once no point's relative velocity
+  // changed by more than velocity_tolerance since the previous sweep: the
+  // motion has converged, even where the impulses of redundant points (four
+  // corners where three would carry the load) still trade load between them.
   velocity_sweeps_ = 0;
   while (velocity_sweeps_ < settings_.velocity_iterations) {
-    double largest_change_squared = 0.0;
-    for (std::size_t r = 0; r < rows_.size();) {
-      const std::uint32_t index_a = rows_[r].body_a;
-      const std::uint32_t index_b = rows_[r].body_b;
-      SolverBody& a = bodies_[index_a];
-      SolverBody& b = bodies_[index_b];
-      Vec3 linear_a = a.linear_velocity;
-      Vec3 angular_a = a.angular_velocity;
-      Vec3 linear_b = b.linear_velocity;
-      Vec3 angular_b = b.angular_velocity;
-      for (; r < rows_.size() && rows_[r].body_a == index_a && rows_[r].body_b == index_b; ++r) {
-        RestingRow& row = rows_[r];
-        const Vec3 v = linear_a + angular_a.cross(row.r_a) - linear_b - angular_b.cross(row.r_b);
-        largest_change_squared =
-            std::max(largest_change_squared, (v - row.last_velocity).squaredNorm());
-        row.last_velocity = v;
-        Vec3 change = Vec3::Zero();  // normal, tangent 0, tangent 1
-        double normal_velocity = row.normal.dot(v);
-        if (row.friction > 0.0) {
-          const std::array<double, 2> old_tangent = row.tangent_impulse;
-          for (int k = 0; k < 2; ++k) {
-            row.tangent_impulse[k] -= row.tangent_mass * row.tangent[k].dot(v);
-          }
-          ClampToDisc(row.friction * row.normal_impulse, &row.tangent_impulse);
-          for (int k = 0; k < 2; ++k) {
-            change[k + 1] = row.tangent_impulse[k] - old_tangent[k];
-            normal_velocity += row.normal_coupling[k] * change[k + 1];
-          }
-        }
-        const double old_normal = row.normal_impulse;
-        row.normal_impulse =
-            std::max(0.0, old_normal + row.normal_mass * (row.target - normal_velocity));
-        change[0] = row.normal_impulse - old_normal;
-        const Vec3 impulse_world =
-            change[0] * row.normal + change[1] * row.tangent[0] + change[2] * row.tangent[1];
-        linear_a += row.inverse_mass_a * impulse_world;
-        angular_a += change[0] * row.angular_a[0] + change[1] * row.angular_a[1] +
-                     change[2] * row.angular_a[2];
-        linear_b -= row.inverse_mass_b * impulse_world;
-        angular_b -= change[0] * row.angular_b[0] + change[1] * row.angular_b[1] +
-                     change[2] * row.angular_b[2];
-      }
-      a.linear_velocity = linear_a;
-      a.angular_velocity = angular_a;
-      b.linear_velocity = linear_b;
-      b.angular_velocity = angular_b;
-    }
+    const double largest_change_squared = SweepSchedule</*kPseudo=*/false>();
     ++velocity_sweeps_;
     // The first sweep has no sweep before it to compare with.
     if (velocity_sweeps_ > 1 &&
@@ -480,37 +651,9 @@ void ContactSolver::SolveRestingContacts() {
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
   // without touching the real velocities, so no energy is added. The same
-  // runs of rows per body pair.
-  const double inverse_dt = 1.0 / time_step_;
+  // schedule.
   for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
-    for (std::size_t r = 0; r < rows_.size();) {
-      const std::uint32_t index_a = rows_[r].body_a;
-      const std::uint32_t index_b = rows_[r].body_b;
-      SolverBody& a = bodies_[index_a];
-      SolverBody& b = bodies_[index_b];
-      Vec3 linear_a = a.pseudo_linear_velocity;
-      Vec3 angular_a = a.pseudo_angular_velocity;
-      Vec3 linear_b = b.pseudo_linear_velocity;
-      Vec3 angular_b = b.pseudo_angular_velocity;
-      for (; r < rows_.size() && rows_[r].body_a == index_a && rows_[r].body_b == index_b; ++r) {
-        RestingRow& row = rows_[r];
-        if (row.depth <= 0.0) continue;
-        const double target = settings_.position_correction * row.depth * inverse_dt;
-        const double v_r = row.normal.dot(linear_a + angular_a.cross(row.r_a) - linear_b -
-                                          angular_b.cross(row.r_b));
-        const double old_impulse = row.pseudo_impulse;
-        row.pseudo_impulse = std::max(0.0, old_impulse + row.normal_mass * (target - v_r));
-        const double change = row.pseudo_impulse - old_impulse;
-        linear_a += (row.inverse_mass_a * change) * row.normal;
-        angular_a += change * row.angular_a[0];
-        linear_b -= (row.inverse_mass_b * change) * row.normal;
-        angular_b -= change * row.angular_b[0];
-      }
-      a.pseudo_linear_velocity = linear_a;
-      a.pseudo_angular_velocity = angular_a;
-      b.pseudo_linear_velocity = linear_b;
-      b.pseudo_angular_velocity = angular_b;
-    }
+    SweepSchedule</*kPseudo=*/true>();
   }
   for (const RestingRow& row : rows_) {
     row.point->normal_impulse = row.normal_impulse;

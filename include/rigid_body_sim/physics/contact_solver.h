@@ -27,6 +27,10 @@ struct SolverSettings {
   double velocity_tolerance = 1e-6;
   // Sweeps of the split-impulse position correction per step.
   int position_iterations = 6;
+  // Whether a sweep updates two runs of rows that share no moving body side
+  // by side (ScheduleRuns), which gives bit for bit the result of updating
+  // one run at a time in manifold order (false, the reference) in less time.
+  bool interleave_independent_runs = true;
   // m/s; epsilon of the classification: colliding when v_r < -epsilon,
   // resting when |v_r| <= epsilon.
   double collision_velocity_threshold = 0.01;
@@ -126,6 +130,17 @@ struct RestingRow {
   SolverPoint* point = nullptr;             // where the impulses go back
 };
 
+// Two runs of resting rows, each the adjacent rows of one body pair, that a
+// sweep updates side by side: [first_begin, first_end) and
+// [second_begin, second_end), the second empty when no run could join the
+// first.
+struct SweepTask {
+  std::uint32_t first_begin = 0;
+  std::uint32_t first_end = 0;
+  std::uint32_t second_begin = 0;
+  std::uint32_t second_end = 0;
+};
+
 class ContactSolver {
  public:
   // Starts a new step: keeps the arrays' memory, clears their contents.
@@ -180,8 +195,10 @@ class ContactSolver {
   double NormalVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
+  void ScheduleRuns();
+  template <bool kPseudo>
+  double SweepSchedule();
   void ComputeMasses();
-  void ApplyRowImpulse(const RestingRow& row, const Vec3& components);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
   // One PGS pass over the rows of the given points; returns the largest
@@ -198,6 +215,7 @@ class ContactSolver {
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
   std::vector<RestingRow> rows_;
+  std::vector<SweepTask> schedule_;
 };
 
 }  // namespace rigid_body_sim::physics
