@@ -14,11 +14,13 @@
 //                      [--only a,b]
 //                      [--hull-bench PATH]
 //                      [--velocity-iterations N] [--time-to-sleep S]
+//                      [--velocity-tolerance V]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
-//   their number of runs. --velocity-iterations and --time-to-sleep (s) run
-//   our engine with those solver and sleep settings instead of the
-//   defaults, to measure what a setting costs or buys; the header says so.
+//   their number of runs. --velocity-iterations, --time-to-sleep (s) and
+//   --velocity-tolerance (m/s) run our engine with those solver and sleep
+//   settings instead of the defaults, to measure what a setting costs or
+//   buys; the header says so.
 
 #include <sys/resource.h>
 #include <sys/types.h>
