@@ -51,6 +51,8 @@ struct OurSettingsOverrides {
   int velocity_iterations = 0;       // PGS sweeps per step, at most, >= 1
   double time_to_sleep = 0.0;        // s an island must stay slow before it sleeps, > 0
   double velocity_tolerance = -1.0;  // m/s, the sweeps' early stop, >= 0 (< 0: the default)
+  // 1 or 0: whether the sweeps pair independent runs of rows (-1: the default)
+  int interleave_independent_runs = -1;
 };
 
 std::unique_ptr<Engine> MakeOurEngine(const Scene& scene,

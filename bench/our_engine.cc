@@ -34,6 +34,9 @@ class OurEngine : public Engine {
     if (overrides.velocity_tolerance >= 0.0) {
       settings.solver.velocity_tolerance = overrides.velocity_tolerance;
     }
+    if (overrides.interleave_independent_runs >= 0) {
+      settings.solver.interleave_independent_runs = overrides.interleave_independent_runs == 1;
+    }
     assert(physics::ValidateWorldSettings(settings).ok());
     world_ = std::make_unique<physics::World>(settings);
 

@@ -14,13 +14,13 @@
 //                      [--only a,b]
 //                      [--hull-bench PATH]
 //                      [--velocity-iterations N] [--time-to-sleep S]
-//                      [--velocity-tolerance V]
+//                      [--velocity-tolerance V] [--interleave-independent-runs 0|1]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
-//   their number of runs. --velocity-iterations, --time-to-sleep (s) and
-//   --velocity-tolerance (m/s) run our engine with those solver and sleep
-//   settings instead of the defaults, to measure what a setting costs or
-//   buys; the header says so.
+//   their number of runs. --velocity-iterations, --time-to-sleep (s),
+//   --velocity-tolerance (m/s) and --interleave-independent-runs run our
+//   engine with those solver and sleep settings instead of the defaults, to
+//   measure what a setting costs or buys; the header says so.
 
 #include <sys/resource.h>
 #include <sys/types.h>
@@ -411,6 +411,12 @@ Options ParseOptions(int argc, char** argv) {
       } else {
         options.overrides.velocity_tolerance = tolerance;
       }
+    } else if (key == "--interleave-independent-runs") {
+      if (value != "0" && value != "1") {
+        options.error = "--interleave-independent-runs wants 0 or 1, got " + value;
+      } else {
+        options.overrides.interleave_independent_runs = value == "1" ? 1 : 0;
+      }
     } else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
     }
@@ -469,6 +475,10 @@ int Main(int argc, char** argv) {
   if (options.overrides.velocity_tolerance >= 0.0) {
     std::printf("ours: velocity_tolerance = %g m/s instead of the default\n",
                 options.overrides.velocity_tolerance);
+  }
+  if (options.overrides.interleave_independent_runs >= 0) {
+    std::printf("ours: interleave_independent_runs = %s\n",
+                options.overrides.interleave_independent_runs == 1 ? "true" : "false");
   }
   std::printf(
       "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "
