@@ -562,8 +562,8 @@ template <bool kPseudo>
 // past runs it shares no moving body with, to be updated side by side with
 // the run it then follows. A sweep in this order gives bit for bit the
 // sweep in manifold order, while the processor overlaps two independent
-// chains of updates: a sweep is bound by the latency of one update feeding
-// the next, not by memory or arithmetic. Greedy, in manifold order: each
+// chains of updates, where one chain leaves it waiting on each update's
+// result (a third chain measured no faster). Greedy, in manifold order: each
 // run not yet scheduled takes the first of the next kPartnerWindow such runs
 // that shares no moving body with it nor with the runs it would pass.
 void ContactSolver::ScheduleRuns() {
