@@ -140,8 +140,8 @@ TEST(StackingTest, ThousandBoxPileSettles) {
 // Gauss-Seidel updates of rows that share no moving body commute exactly, so
 // the sweep that updates two such runs side by side must reproduce the
 // sweep in manifold order bit for bit: every pose and velocity equal, not
-// close, after a pile of 64 boxes has landed and settled (many runs of rows
-// per body, the ground shared by all).
+// close, after a pile of 64 boxes has landed (several runs of rows per box,
+// the ground shared by all).
 TEST(StackingTest, InterleavedSweepsMatchTheOneRunAtATimeReferenceBitForBit) {
   auto make_pile = [](bool interleave, std::vector<BodyId>* boxes) {
     WorldSettings settings;
@@ -171,7 +171,8 @@ TEST(StackingTest, InterleavedSweepsMatchTheOneRunAtATimeReferenceBitForBit) {
     largest_point_count =
         std::max(largest_point_count, static_cast<int>(world->last_step_profile().solver_points));
   }
-  // The pile has landed: its rows are many runs, most of them paired.
+  // The pile has landed: hundreds of rows in runs of up to four (a
+  // scheduler that pairs runs sharing a box fails the comparison below).
   EXPECT_GT(largest_point_count, 200);
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const Pose pose = world->GetPose(boxes[i]);
