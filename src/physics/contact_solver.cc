@@ -405,27 +405,30 @@ struct RunVelocities {
   Vec3 angular_b;
 };
 
-RunVelocities LoadVelocities(const SolverBody& a, const SolverBody& b) {
-  return {a.linear_velocity, a.angular_velocity, b.linear_velocity, b.angular_velocity};
+// The two bodies' real velocities, or with kPseudo the split impulse's.
+template <bool kPseudo>
+RunVelocities LoadRun(const SolverBody& a, const SolverBody& b) {
+  if constexpr (kPseudo) {
+    return {a.pseudo_linear_velocity, a.pseudo_angular_velocity, b.pseudo_linear_velocity,
+            b.pseudo_angular_velocity};
+  } else {
+    return {a.linear_velocity, a.angular_velocity, b.linear_velocity, b.angular_velocity};
+  }
 }
 
-void StoreVelocities(const RunVelocities& velocities, SolverBody* a, SolverBody* b) {
-  a->linear_velocity = velocities.linear_a;
-  a->angular_velocity = velocities.angular_a;
-  b->linear_velocity = velocities.linear_b;
-  b->angular_velocity = velocities.angular_b;
-}
-
-RunVelocities LoadPseudoVelocities(const SolverBody& a, const SolverBody& b) {
-  return {a.pseudo_linear_velocity, a.pseudo_angular_velocity, b.pseudo_linear_velocity,
-          b.pseudo_angular_velocity};
-}
-
-void StorePseudoVelocities(const RunVelocities& velocities, SolverBody* a, SolverBody* b) {
-  a->pseudo_linear_velocity = velocities.linear_a;
-  a->pseudo_angular_velocity = velocities.angular_a;
-  b->pseudo_linear_velocity = velocities.linear_b;
-  b->pseudo_angular_velocity = velocities.angular_b;
+template <bool kPseudo>
+void StoreRun(const RunVelocities& velocities, SolverBody* a, SolverBody* b) {
+  if constexpr (kPseudo) {
+    a->pseudo_linear_velocity = velocities.linear_a;
+    a->pseudo_angular_velocity = velocities.angular_a;
+    b->pseudo_linear_velocity = velocities.linear_b;
+    b->pseudo_angular_velocity = velocities.angular_b;
+  } else {
+    a->linear_velocity = velocities.linear_a;
+    a->angular_velocity = velocities.angular_a;
+    b->linear_velocity = velocities.linear_b;
+    b->angular_velocity = velocities.angular_b;
+  }
 }
 
 // Adds the impulse (normal, tangent 0, tangent 1) components of a row to its
@@ -527,10 +530,8 @@ template <bool kPseudo>
     const std::uint32_t second_row = paired ? task.second_begin : task.first_begin;
     SolverBody& second_a = bodies_[rows_[second_row].body_a];
     SolverBody& second_b = bodies_[rows_[second_row].body_b];
-    RunVelocities first =
-        kPseudo ? LoadPseudoVelocities(first_a, first_b) : LoadVelocities(first_a, first_b);
-    RunVelocities second =
-        kPseudo ? LoadPseudoVelocities(second_a, second_b) : LoadVelocities(second_a, second_b);
+    RunVelocities first = LoadRun<kPseudo>(first_a, first_b);
+    RunVelocities second = LoadRun<kPseudo>(second_a, second_b);
     std::uint32_t r = task.first_begin;
     std::uint32_t s = task.second_begin;
     while (r < task.first_end || s < task.second_end) {
@@ -545,13 +546,8 @@ template <bool kPseudo>
                      UpdateRow<kPseudo>(correction, inverse_dt, &rows_[s++], &second));
       }
     }
-    if constexpr (kPseudo) {
-      if (paired) StorePseudoVelocities(second, &second_a, &second_b);
-      StorePseudoVelocities(first, &first_a, &first_b);
-    } else {
-      if (paired) StoreVelocities(second, &second_a, &second_b);
-      StoreVelocities(first, &first_a, &first_b);
-    }
+    if (paired) StoreRun<kPseudo>(second, &second_a, &second_b);
+    StoreRun<kPseudo>(first, &first_a, &first_b);
   }
   return largest_change_squared;
 }
@@ -627,10 +623,10 @@ void ContactSolver::SolveRestingContacts() {
   for (const RestingRow& row : rows_) {
     SolverBody& a = bodies_[row.body_a];
     SolverBody& b = bodies_[row.body_b];
-    RunVelocities velocities = LoadVelocities(a, b);
+    RunVelocities velocities = LoadRun</*kPseudo=*/false>(a, b);
     AddRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]),
                   &velocities);
-    StoreVelocities(velocities, &a, &b);
+    StoreRun</*kPseudo=*/false>(velocities, &a, &b);
   }
 
   // Projected Gauss-Seidel, one block per point (UpdateRestingRow), in the
