@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "scene.h"
@@ -45,14 +46,13 @@ class Engine {
 constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines
 
 // Settings of our engine that a benchmark run may set to other values than
-// the defaults, to measure what they cost and what they buy; 0 keeps the
-// default (physics::WorldSettings).
+// the defaults, to measure what they cost and what they buy; unset keeps
+// the default (physics::WorldSettings).
 struct OurSettingsOverrides {
-  int velocity_iterations = 0;       // PGS sweeps per step, at most, >= 1
-  double time_to_sleep = 0.0;        // s an island must stay slow before it sleeps, > 0
-  double velocity_tolerance = -1.0;  // m/s, the sweeps' early stop, >= 0 (< 0: the default)
-  // 1 or 0: whether the sweeps pair independent runs of rows (-1: the default)
-  int interleave_independent_runs = -1;
+  std::optional<int> velocity_iterations;    // PGS sweeps per step, at most, >= 1
+  std::optional<double> time_to_sleep;       // s an island must stay slow before it sleeps, > 0
+  std::optional<double> velocity_tolerance;  // m/s, the sweeps' early stop, >= 0
+  std::optional<bool> interleave_independent_runs;  // the sweeps pair independent runs of rows
 };
 
 std::unique_ptr<Engine> MakeOurEngine(const Scene& scene,

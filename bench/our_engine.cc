@@ -27,16 +27,12 @@ class OurEngine : public Engine {
   OurEngine(const Scene& scene, const OurSettingsOverrides& overrides) {
     physics::WorldSettings settings;
     settings.time_step = kTimeStep;
-    if (overrides.velocity_iterations > 0) {
-      settings.solver.velocity_iterations = overrides.velocity_iterations;
-    }
-    if (overrides.time_to_sleep > 0.0) settings.sleep.time_to_sleep = overrides.time_to_sleep;
-    if (overrides.velocity_tolerance >= 0.0) {
-      settings.solver.velocity_tolerance = overrides.velocity_tolerance;
-    }
-    if (overrides.interleave_independent_runs >= 0) {
-      settings.solver.interleave_independent_runs = overrides.interleave_independent_runs == 1;
-    }
+    physics::SolverSettings& solver = settings.solver;
+    solver.velocity_iterations = overrides.velocity_iterations.value_or(solver.velocity_iterations);
+    solver.velocity_tolerance = overrides.velocity_tolerance.value_or(solver.velocity_tolerance);
+    solver.interleave_independent_runs =
+        overrides.interleave_independent_runs.value_or(solver.interleave_independent_runs);
+    settings.sleep.time_to_sleep = overrides.time_to_sleep.value_or(settings.sleep.time_to_sleep);
     assert(physics::ValidateWorldSettings(settings).ok());
     world_ = std::make_unique<physics::World>(settings);
 

@@ -415,7 +415,7 @@ Options ParseOptions(int argc, char** argv) {
       if (value != "0" && value != "1") {
         options.error = "--interleave-independent-runs wants 0 or 1, got " + value;
       } else {
-        options.overrides.interleave_independent_runs = value == "1" ? 1 : 0;
+        options.overrides.interleave_independent_runs = value == "1";
       }
     } else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
@@ -464,21 +464,21 @@ int Main(int argc, char** argv) {
         "%d run(s)\n\n",
         window_seconds, options.large_runs);
   }
-  if (options.overrides.velocity_iterations > 0) {
+  const OurSettingsOverrides& overrides = options.overrides;
+  if (overrides.velocity_iterations) {
     std::printf("ours: velocity_iterations = %d instead of the default\n",
-                options.overrides.velocity_iterations);
+                *overrides.velocity_iterations);
   }
-  if (options.overrides.time_to_sleep > 0.0) {
-    std::printf("ours: time_to_sleep = %g s instead of the default\n",
-                options.overrides.time_to_sleep);
+  if (overrides.time_to_sleep) {
+    std::printf("ours: time_to_sleep = %g s instead of the default\n", *overrides.time_to_sleep);
   }
-  if (options.overrides.velocity_tolerance >= 0.0) {
+  if (overrides.velocity_tolerance) {
     std::printf("ours: velocity_tolerance = %g m/s instead of the default\n",
-                options.overrides.velocity_tolerance);
+                *overrides.velocity_tolerance);
   }
-  if (options.overrides.interleave_independent_runs >= 0) {
+  if (overrides.interleave_independent_runs) {
     std::printf("ours: interleave_independent_runs = %s\n",
-                options.overrides.interleave_independent_runs == 1 ? "true" : "false");
+                *overrides.interleave_independent_runs ? "true" : "false");
   }
   std::printf(
       "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "
