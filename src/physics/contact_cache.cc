@@ -21,6 +21,16 @@ std::uint64_t ContactCache::Key(std::uint32_t body_a, std::uint16_t shape_a, std
          (std::uint64_t{shape_a} << 12) | std::uint64_t{shape_b};
 }
 
+void ContactCache::PrefetchPair(Prefetch stage, std::uint32_t body_a, std::uint16_t shape_a,
+                                std::uint32_t body_b, std::uint16_t shape_b) const {
+  const std::uint64_t key = Key(body_a, shape_a, body_b, shape_b);
+  if (stage == Prefetch::kSlot) {
+    index_.PrefetchSlot(key);
+  } else if (const ShapePairContact* entry = index_.Find(key)) {
+    __builtin_prefetch(entry);
+  }
+}
+
 ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_a,
                                       std::uint32_t body_b, std::uint16_t shape_b,
                                       std::uint64_t step) {
@@ -84,7 +94,11 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
   // then the half-space pairs by body).
   seen_.swap(visited_);
   visited_.clear();
-  for (ShapePairContact* entry : seen_) {
+  for (std::size_t e = 0; e < seen_.size(); ++e) {
+    if (e + kEntryPrefetchDistance < seen_.size()) {
+      PrefetchPoints(*seen_[e + kEntryPrefetchDistance]);
+    }
+    ShapePairContact* entry = seen_[e];
     if (entry->manifold.point_count == 0) {
       entry->previous_count = 0;
       continue;

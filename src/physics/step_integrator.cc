@@ -13,32 +13,6 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-// Where a body is at time t in [0, dt] of the step: the position follows the
-// trapezoidal drift exactly (a parabola between the two velocities), the
-// orientation is interpolated by slerp.
-struct BodyPath {
-  Pose start;                           // world_from_principal at t = 0
-  Pose end;                             // at t = dt
-  Vec3 start_velocity = Vec3::Zero();   // m/s, after the collision impulses
-  Vec3 end_velocity = Vec3::Zero();     // m/s
-  Vec3 pseudo_velocity = Vec3::Zero();  // m/s
-  double dt = 0.0;                      // s; 0 for a body that does not move
-  bool fast = false;                    // sampled along its path
-  double reach = 0.0;                   // m, the furthest any point moves
-
-  Pose At(double t) const {
-    const double s = t / dt;
-    Pose pose;
-    pose.translation = start.translation + t * start_velocity +
-                       0.5 * t * t / dt * (end_velocity - start_velocity) + t * pseudo_velocity;
-    pose.rotation = start.rotation.slerp(s, end.rotation);
-    return pose;
-  }
-  Vec3 VelocityAt(double t) const {
-    return start_velocity + (t / dt) * (end_velocity - start_velocity);
-  }
-};
-
 // Bisection stops when the bracket is shorter than this fraction of the step.
 constexpr double kTimeOfImpactTolerance = 1e-6;
 
@@ -77,7 +51,11 @@ class UnionFind {
 // wall it would pass through entirely still shows a penetrating sample to
 // bracket. Pairs that cannot close their gap within the step are skipped.
 void World::IntegrateBodies(double dt) {
-  std::vector<BodyPath> paths(bodies_.size());
+  // Kept between steps, so that a step neither allocates nor clears a path
+  // per body: outside this function every entry reads as a body that does
+  // not move (dt 0, not fast, reach 0), whatever its other fields hold.
+  std::vector<BodyPath>& paths = paths_;
+  paths.resize(bodies_.size());
   for (const std::uint32_t i : moving_bodies_) {
     const Body& body = bodies_[i];
     if (!body.awake) continue;
@@ -122,7 +100,12 @@ void World::IntegrateBodies(double dt) {
   // groups of linked impacts instead would let one grazing pair hold every
   // body of a pile at the start of its step, step after step.
   std::vector<double> impact_time(bodies_.size(), std::numeric_limits<double>::infinity());
-  for (ShapePairContact* pair : contact_cache_.seen()) {
+  const std::vector<ShapePairContact*>& seen = contact_cache_.seen();
+  for (std::size_t e = 0; e < seen.size(); ++e) {
+    if (e + kEntryPrefetchDistance < seen.size()) {
+      PrefetchManifold(*seen[e + kEntryPrefetchDistance]);
+    }
+    ShapePairContact* pair = seen[e];
     // The gap at the start: the nearest point of the manifold, or, with no
     // point, at least the distance the narrow phase looked within, and at
     // least the narrow phase's separating-axis gap less what the bodies
@@ -259,6 +242,11 @@ void World::IntegrateBodies(double dt) {
     body.linear_momentum = body.mass * paths[i].VelocityAt(time);
     body.UpdateDerived();
     body.start_linear_velocity = body.linear_velocity;
+  }
+  for (const std::uint32_t i : moving_bodies_) {
+    paths[i].dt = 0.0;
+    paths[i].fast = false;
+    paths[i].reach = 0.0;
   }
   UpdateSleep(dt);
 }

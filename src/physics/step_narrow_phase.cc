@@ -10,12 +10,35 @@
 
 namespace rigid_body_sim::physics {
 
+namespace {
+
+// Visits ahead of a pair's own at which its cache slot, then its cache
+// entry, start loading: each load takes about as long as a few visits.
+constexpr std::size_t kSlotPrefetchAhead = 16;
+constexpr std::size_t kEntryPrefetchAhead = 8;
+
+}  // namespace
+
 void World::UpdateNarrowPhase(double dt) {
   ++step_count_;
   last_step_profile_.reused_manifolds = 0;
-  for (const ProxyPair& pair : broad_phase_.Pairs()) {
-    CollideBodies(static_cast<std::uint32_t>(pair.first), static_cast<std::uint32_t>(pair.second),
-                  dt);
+  const std::vector<ProxyPair>& pairs = broad_phase_.Pairs();
+  // The body pair in CollideBodies' order, for its first shapes' cache entry.
+  auto prefetch = [&](ContactCache::Prefetch stage, std::size_t k) {
+    if (k >= pairs.size()) return;
+    auto a = static_cast<std::uint32_t>(pairs[k].first);
+    auto b = static_cast<std::uint32_t>(pairs[k].second);
+    if (bodies_[a].is_static || !bodies_[a].awake) std::swap(a, b);
+    contact_cache_.PrefetchPair(stage, a, 0, b, 0);
+  };
+  for (std::size_t k = 0; k < std::min(pairs.size(), kSlotPrefetchAhead); ++k) {
+    prefetch(ContactCache::Prefetch::kSlot, k);
+  }
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    prefetch(ContactCache::Prefetch::kSlot, k + kSlotPrefetchAhead);
+    prefetch(ContactCache::Prefetch::kEntry, k + kEntryPrefetchAhead);
+    CollideBodies(static_cast<std::uint32_t>(pairs[k].first),
+                  static_cast<std::uint32_t>(pairs[k].second), dt);
   }
   for (const std::uint32_t plane : half_space_bodies_) {
     const Pose world_from_plane =

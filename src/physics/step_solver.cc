@@ -182,7 +182,11 @@ void World::SolveContacts(double dt) {
   LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
   manifolds.reserve(pairs.size());
-  for (const ShapePairContact* pair : pairs) {
+  for (std::size_t m = 0; m < pairs.size(); ++m) {
+    if (m + kEntryPrefetchDistance < pairs.size()) {
+      PrefetchPoints(*pairs[m + kEntryPrefetchDistance]);
+    }
+    const ShapePairContact* pair = pairs[m];
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
     // Built in place: a manifold with its four points is 648 bytes.
@@ -249,6 +253,9 @@ void World::SolveContacts(double dt) {
   // Keep the impulses for next step's warm start, and report the points
   // that touch.
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
+    if (m + kEntryPrefetchDistance < pairs.size()) {
+      PrefetchPoints(*pairs[m + kEntryPrefetchDistance]);
+    }
     const SolverManifold& manifold = manifolds[m];
     ShapePairContact& pair = *pairs[m];
     pair.previous_count = manifold.point_count;

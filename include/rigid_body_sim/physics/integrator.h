@@ -10,6 +10,32 @@
 
 namespace rigid_body_sim::physics {
 
+// Where a body is at time t in [0, dt] of the step: the position follows the
+// trapezoidal drift exactly (a parabola between the two velocities), the
+// orientation is interpolated by slerp.
+struct BodyPath {
+  Pose start;                           // world_from_principal at t = 0
+  Pose end;                             // at t = dt
+  Vec3 start_velocity = Vec3::Zero();   // m/s, after the collision impulses
+  Vec3 end_velocity = Vec3::Zero();     // m/s
+  Vec3 pseudo_velocity = Vec3::Zero();  // m/s
+  double dt = 0.0;                      // s; 0 for a body that does not move
+  bool fast = false;                    // sampled along its path
+  double reach = 0.0;                   // m, the furthest any point moves
+
+  Pose At(double t) const {
+    const double s = t / dt;
+    Pose pose;
+    pose.translation = start.translation + t * start_velocity +
+                       0.5 * t * t / dt * (end_velocity - start_velocity) + t * pseudo_velocity;
+    pose.rotation = start.rotation.slerp(s, end.rotation);
+    return pose;
+  }
+  Vec3 VelocityAt(double t) const {
+    return start_velocity + (t / dt) * (end_velocity - start_velocity);
+  }
+};
+
 // Kick: P += (F + M g) dt and L += tau dt for the awake bodies of `moving`, then
 // clears the force and torque accumulators. Records v before the kick for
 // the trapezoidal drift.

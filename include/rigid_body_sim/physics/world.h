@@ -11,6 +11,7 @@
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/contact_cache.h"
 #include "rigid_body_sim/physics/contact_solver.h"
+#include "rigid_body_sim/physics/integrator.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/types.h"
 
@@ -148,6 +149,7 @@ class World {
   std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
   std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
+  std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
   std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
