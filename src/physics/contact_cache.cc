@@ -95,9 +95,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
   seen_.swap(visited_);
   visited_.clear();
   for (std::size_t e = 0; e < seen_.size(); ++e) {
-    if (e + kEntryPrefetchDistance < seen_.size()) {
-      PrefetchPoints(*seen_[e + kEntryPrefetchDistance]);
-    }
+    PrefetchAhead(seen_, e, PrefetchPoints);
     ShapePairContact* entry = seen_[e];
     if (entry->manifold.point_count == 0) {
       entry->previous_count = 0;

@@ -102,9 +102,7 @@ void World::IntegrateBodies(double dt) {
   std::vector<double> impact_time(bodies_.size(), std::numeric_limits<double>::infinity());
   const std::vector<ShapePairContact*>& seen = contact_cache_.seen();
   for (std::size_t e = 0; e < seen.size(); ++e) {
-    if (e + kEntryPrefetchDistance < seen.size()) {
-      PrefetchManifold(*seen[e + kEntryPrefetchDistance]);
-    }
+    PrefetchAhead(seen, e, PrefetchManifold);
     ShapePairContact* pair = seen[e];
     // The gap at the start: the nearest point of the manifold, or, with no
     // point, at least the distance the narrow phase looked within, and at

@@ -17,6 +17,13 @@ namespace {
 constexpr std::size_t kSlotPrefetchAhead = 16;
 constexpr std::size_t kEntryPrefetchAhead = 8;
 
+// Puts the moving body of a pair first when only one moves, so that normals
+// point from the static or sleeping body B into A (CollideBodies).
+void MovingBodyFirst(const std::vector<Body>& bodies, std::uint32_t* body_a,
+                     std::uint32_t* body_b) {
+  if (bodies[*body_a].is_static || !bodies[*body_a].awake) std::swap(*body_a, *body_b);
+}
+
 }  // namespace
 
 void World::UpdateNarrowPhase(double dt) {
@@ -28,7 +35,7 @@ void World::UpdateNarrowPhase(double dt) {
     if (k >= pairs.size()) return;
     auto a = static_cast<std::uint32_t>(pairs[k].first);
     auto b = static_cast<std::uint32_t>(pairs[k].second);
-    if (bodies_[a].is_static || !bodies_[a].awake) std::swap(a, b);
+    MovingBodyFirst(bodies_, &a, &b);
     contact_cache_.PrefetchPair(stage, a, 0, b, 0);
   };
   for (std::size_t k = 0; k < std::min(pairs.size(), kSlotPrefetchAhead); ++k) {
@@ -132,7 +139,7 @@ void World::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
 // either has moved far enough to bring them within it (conservative
 // advancement's bound, kept across steps).
 void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
-  if (bodies_[body_a].is_static || !bodies_[body_a].awake) std::swap(body_a, body_b);
+  MovingBodyFirst(bodies_, &body_a, &body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
   const double contact_distance = ContactDistance(a, b, dt);

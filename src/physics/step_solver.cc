@@ -183,9 +183,7 @@ void World::SolveContacts(double dt) {
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
   manifolds.reserve(pairs.size());
   for (std::size_t m = 0; m < pairs.size(); ++m) {
-    if (m + kEntryPrefetchDistance < pairs.size()) {
-      PrefetchPoints(*pairs[m + kEntryPrefetchDistance]);
-    }
+    PrefetchAhead(pairs, m, PrefetchPoints);
     const ShapePairContact* pair = pairs[m];
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
@@ -253,9 +251,7 @@ void World::SolveContacts(double dt) {
   // Keep the impulses for next step's warm start, and report the points
   // that touch.
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
-    if (m + kEntryPrefetchDistance < pairs.size()) {
-      PrefetchPoints(*pairs[m + kEntryPrefetchDistance]);
-    }
+    PrefetchAhead(pairs, m, PrefetchPoints);
     const SolverManifold& manifold = manifolds[m];
     ShapePairContact& pair = *pairs[m];
     pair.previous_count = manifold.point_count;

@@ -92,11 +92,20 @@ inline void PrefetchPoints(const ShapePairContact& entry) {
   PrefetchBytes(&entry.warm_start, sizeof(entry.warm_start) + sizeof(entry.previous));
 }
 
+// For a walk over `entries` now at `index`: `prefetch` (PrefetchManifold or
+// PrefetchPoints) of the entry kEntryPrefetchDistance ahead, if there is one.
+inline void PrefetchAhead(const std::vector<ShapePairContact*>& entries, std::size_t index,
+                          void (*prefetch)(const ShapePairContact&)) {
+  if (index + kEntryPrefetchDistance < entries.size()) {
+    prefetch(*entries[index + kEntryPrefetchDistance]);
+  }
+}
+
 class ContactCache {
  public:
-  // Starts loading what a Touch of the pair will read, `ahead` visits
-  // before it: kSlot its index slot, kEntry (once the slot is loaded) the
-  // entry itself. Changes nothing.
+  // Starts loading what a Touch of the pair will read, some visits before
+  // it: kSlot its index slot, kEntry (once the slot is loaded) the entry
+  // itself. Changes nothing.
   enum class Prefetch { kSlot, kEntry };
   void PrefetchPair(Prefetch stage, std::uint32_t body_a, std::uint16_t shape_a,
                     std::uint32_t body_b, std::uint16_t shape_b) const;
