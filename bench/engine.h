@@ -20,6 +20,9 @@ struct StageTimes {
   double integrator_ms = 0.0;     // ours and Bullet's: integration and sleeping
   std::size_t solver_points = 0;  // contact points the solver saw
   int velocity_iterations = 0;    // velocity sweeps of the solver in this step
+  // Point updates of those sweeps; ours sweeps each island to its own
+  // convergence, so it may update fewer than points x iterations.
+  std::size_t point_iterations = 0;
 };
 
 class Engine {

@@ -136,8 +136,7 @@ RunResult RunScene(const Scene& scene, bool bullet, const RunSettings& settings)
     result.solver_ms += stages.solver_ms;
     result.integrator_ms += stages.integrator_ms;
     if (stages.solver_points > 0) {
-      result.solver_point_iterations +=
-          static_cast<double>(stages.solver_points) * stages.velocity_iterations;
+      result.solver_point_iterations += static_cast<double>(stages.point_iterations);
       result.solver_rows_ms += stages.solver_ms;
       ++result.contact_steps;
       result.contact_steps_ms += step_ms;

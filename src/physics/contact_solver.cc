@@ -395,6 +395,12 @@ constexpr int kPartnerWindow = 4;
 // only such bodies are independent.
 constexpr std::uint32_t kFixedBody = std::numeric_limits<std::uint32_t>::max();
 
+// Whether the solve can move a body: static and sleeping ones have zero
+// inverse mass and inertia.
+bool Moves(const SolverBody& body) {
+  return body.inverse_mass != 0.0 || (body.inverse_inertia_world.array() != 0.0).any();
+}
+
 // The velocities of the two bodies of one run of rows, held in locals while
 // the run's rows update them, so that one row's result reaches the next in
 // registers instead of through memory.
@@ -511,45 +517,67 @@ double UpdateRow(double position_correction, double inverse_dt, RestingRow* row,
 }  // namespace
 
 // One sweep over the schedule, the two runs of a task alternately: the
-// resting rows' Gauss-Seidel update on the real velocities, or with kPseudo
-// the split impulse's on the pseudo velocities. Returns the largest
-// |v - v_previous sweep|^2 of a point (0 with kPseudo), m^2/s^2. Flattened:
-// with any update left a call, a run's velocities stay in memory and the
-// sweep takes 30 % longer.
+// resting rows' Gauss-Seidel update on the real velocities, which skips the
+// runs of converged islands and records each island's largest
+// |v - v_previous sweep|^2, or with kPseudo the split impulse's on the
+// pseudo velocities, over every island. Flattened: with any update left a
+// call, a run's velocities stay in memory and the sweep takes 30 % longer.
 template <bool kPseudo>
-[[gnu::flatten]] double ContactSolver::SweepSchedule() {
+[[gnu::flatten]] void ContactSolver::SweepSchedule() {
   const double correction = settings_.position_correction;
   const double inverse_dt = 1.0 / time_step_;
-  double largest_change_squared = 0.0;
   for (const SweepTask& task : schedule_) {
-    const bool paired = task.second_begin != task.second_end;
-    SolverBody& first_a = bodies_[rows_[task.first_begin].body_a];
-    SolverBody& first_b = bodies_[rows_[task.first_begin].body_b];
+    std::uint32_t first_begin = task.first_begin;
+    std::uint32_t first_end = task.first_end;
+    std::uint32_t first_island = task.first_island;
+    std::uint32_t second_begin = task.second_begin;
+    std::uint32_t second_end = task.second_end;
+    if constexpr (!kPseudo) {
+      if (islands_[task.second_island].converged) second_end = second_begin;
+      if (islands_[first_island].converged) {
+        first_begin = second_begin;
+        first_end = second_end;
+        first_island = task.second_island;
+        second_end = second_begin;
+      }
+      if (first_begin == first_end) continue;
+    }
+    const bool paired = second_begin != second_end;
+    SolverBody& first_a = bodies_[rows_[first_begin].body_a];
+    SolverBody& first_b = bodies_[rows_[first_begin].body_b];
     // An unpaired task loads its first run's bodies as the second run's too;
     // the empty second run never updates or stores them.
-    const std::uint32_t second_row = paired ? task.second_begin : task.first_begin;
+    const std::uint32_t second_row = paired ? second_begin : first_begin;
     SolverBody& second_a = bodies_[rows_[second_row].body_a];
     SolverBody& second_b = bodies_[rows_[second_row].body_b];
     RunVelocities first = LoadRun<kPseudo>(first_a, first_b);
     RunVelocities second = LoadRun<kPseudo>(second_a, second_b);
-    std::uint32_t r = task.first_begin;
-    std::uint32_t s = task.second_begin;
-    while (r < task.first_end || s < task.second_end) {
-      if (r < task.first_end) {
-        largest_change_squared =
-            std::max(largest_change_squared,
-                     UpdateRow<kPseudo>(correction, inverse_dt, &rows_[r++], &first));
+    double first_change_squared = 0.0;
+    double second_change_squared = 0.0;
+    std::uint32_t r = first_begin;
+    std::uint32_t s = second_begin;
+    while (r < first_end || s < second_end) {
+      if (r < first_end) {
+        first_change_squared = std::max(
+            first_change_squared, UpdateRow<kPseudo>(correction, inverse_dt, &rows_[r++], &first));
       }
-      if (s < task.second_end) {
-        largest_change_squared =
-            std::max(largest_change_squared,
+      if (s < second_end) {
+        second_change_squared =
+            std::max(second_change_squared,
                      UpdateRow<kPseudo>(correction, inverse_dt, &rows_[s++], &second));
       }
     }
     if (paired) StoreRun<kPseudo>(second, &second_a, &second_b);
     StoreRun<kPseudo>(first, &first_a, &first_b);
+    if constexpr (!kPseudo) {
+      double& first_largest = islands_[first_island].largest_change_squared;
+      first_largest = std::max(first_largest, first_change_squared);
+      if (paired) {
+        double& second_largest = islands_[task.second_island].largest_change_squared;
+        second_largest = std::max(second_largest, second_change_squared);
+      }
+    }
   }
-  return largest_change_squared;
 }
 
 // Gauss-Seidel updates of rows that share no body the solve can move commute
@@ -569,12 +597,7 @@ void ContactSolver::ScheduleRuns() {
     std::array<std::uint32_t, 2> moving;  // kFixedBody for a body that does not move
     bool scheduled;
   };
-  auto moving = [&](std::uint32_t index) {
-    const SolverBody& body = bodies_[index];
-    const bool moves =
-        body.inverse_mass != 0.0 || (body.inverse_inertia_world.array() != 0.0).any();
-    return moves ? index : kFixedBody;
-  };
+  auto moving = [&](std::uint32_t index) { return Moves(bodies_[index]) ? index : kFixedBody; };
   std::vector<Run> runs;
   for (std::uint32_t r = 0; r < rows_.size();) {
     const std::uint32_t begin = r;
@@ -600,6 +623,7 @@ void ContactSolver::ScheduleRuns() {
     task.first_begin = runs[i].begin;
     task.first_end = runs[i].end;
     task.second_begin = task.second_end = runs[i].end;
+    task.first_island = task.second_island = row_island_[runs[i].begin];
     blocked.assign(runs[i].moving.begin(), runs[i].moving.end());
     const int window = settings_.interleave_independent_runs ? kPartnerWindow : 0;
     int looked = 0;
@@ -610,6 +634,7 @@ void ContactSolver::ScheduleRuns() {
         runs[j].scheduled = true;
         task.second_begin = runs[j].begin;
         task.second_end = runs[j].end;
+        task.second_island = row_island_[runs[j].begin];
         break;
       }
       blocked.insert(blocked.end(), runs[j].moving.begin(), runs[j].moving.end());
@@ -617,8 +642,40 @@ void ContactSolver::ScheduleRuns() {
   }
 }
 
+// Rows of different islands share no body the solve moves, so a sweep's
+// updates of one island never read another's results, and an island can
+// stop sweeping once it alone has converged: a quiet island stops early
+// while a busy one goes on, and each island's rows are updated in the same
+// order as if it were alone in the world. Islands by union-find over the
+// rows' moving bodies, numbered in the order of their first row.
+void ContactSolver::FindIslands() {
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  island_sets_.Reset(bodies_.size());
+  for (const RestingRow& row : rows_) {
+    if (Moves(bodies_[row.body_a]) && Moves(bodies_[row.body_b])) {
+      island_sets_.Join(row.body_a, row.body_b);
+    }
+  }
+  island_of_root_.assign(bodies_.size(), kNone);
+  row_island_.resize(rows_.size());
+  islands_.clear();
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    // A row between two bodies that do not move changes nothing; it joins
+    // the island of body A.
+    const std::uint32_t body = Moves(bodies_[rows_[r].body_a]) ? rows_[r].body_a : rows_[r].body_b;
+    std::uint32_t& island = island_of_root_[island_sets_.Find(body)];
+    if (island == kNone) {
+      island = static_cast<std::uint32_t>(islands_.size());
+      islands_.emplace_back();
+    }
+    row_island_[r] = island;
+    ++islands_[island].row_count;
+  }
+}
+
 void ContactSolver::SolveRestingContacts() {
   BuildRestingRows();
+  FindIslands();
   ScheduleRuns();
   for (const RestingRow& row : rows_) {
     SolverBody& a = bodies_[row.body_a];
@@ -630,24 +687,33 @@ void ContactSolver::SolveRestingContacts() {
   }
 
   // Projected Gauss-Seidel, one block per point (UpdateRestingRow), in the
-  // schedule's order. Sweeps stop early once no point's relative velocity
-  // changed by more than velocity_tolerance since the previous sweep: the
-  // motion has converged, even where the impulses of redundant points (four
-  // corners where three would carry the load) still trade load between them.
+  // schedule's order. An island stops sweeping once none of its points'
+  // relative velocities changed by more than velocity_tolerance since the
+  // previous sweep: its motion has converged, even where the impulses of
+  // redundant points (four corners where three would carry the load) still
+  // trade load between them.
+  const double tolerance_squared = settings_.velocity_tolerance * settings_.velocity_tolerance;
+  std::size_t sweeping = islands_.size();
   velocity_sweeps_ = 0;
-  while (velocity_sweeps_ < settings_.velocity_iterations) {
-    const double largest_change_squared = SweepSchedule</*kPseudo=*/false>();
+  velocity_row_updates_ = 0;
+  while (sweeping > 0 && velocity_sweeps_ < settings_.velocity_iterations) {
+    SweepSchedule</*kPseudo=*/false>();
     ++velocity_sweeps_;
-    // The first sweep has no sweep before it to compare with.
-    if (velocity_sweeps_ > 1 &&
-        largest_change_squared <= settings_.velocity_tolerance * settings_.velocity_tolerance) {
-      break;
+    for (RestingIsland& island : islands_) {
+      if (island.converged) continue;
+      velocity_row_updates_ += island.row_count;
+      // The first sweep has no sweep before it to compare with.
+      if (velocity_sweeps_ > 1 && island.largest_change_squared <= tolerance_squared) {
+        island.converged = true;
+        --sweeping;
+      }
+      island.largest_change_squared = 0.0;
     }
   }
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
   // without touching the real velocities, so no energy is added. The same
-  // schedule.
+  // schedule, every island.
   for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
     SweepSchedule</*kPseudo=*/true>();
   }

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <variant>
 
 #include "rigid_body_sim/physics/integrator.h"
 #include "rigid_body_sim/physics/narrow_phase.h"
+#include "rigid_body_sim/physics/union_find.h"
 #include "rigid_body_sim/physics/world.h"
 
 namespace rigid_body_sim::physics {
@@ -19,25 +19,6 @@ constexpr double kTimeOfImpactTolerance = 1e-6;
 // Samples along a fast body's path, at most: 2 km/s against a 1 mm thick
 // plate at 240 Hz.
 constexpr double kMaxPathSamples = 1e4;
-
-// Disjoint sets of body indices with path halving.
-class UnionFind {
- public:
-  explicit UnionFind(std::size_t size) : parent_(size) {
-    std::iota(parent_.begin(), parent_.end(), 0u);
-  }
-  std::uint32_t Find(std::uint32_t i) {
-    while (parent_[i] != i) {
-      parent_[i] = parent_[parent_[i]];
-      i = parent_[i];
-    }
-    return i;
-  }
-  void Join(std::uint32_t a, std::uint32_t b) { parent_[Find(a)] = Find(b); }
-
- private:
-  std::vector<std::uint32_t> parent_;
-};
 
 }  // namespace
 

@@ -348,6 +348,7 @@ void World::Step() {
     profile.solver_points += static_cast<std::size_t>(manifold.point_count);
   }
   profile.velocity_sweeps = solver_.velocity_sweeps();
+  profile.velocity_row_updates = solver_.velocity_row_updates();
   time_ += dt;
 }
 

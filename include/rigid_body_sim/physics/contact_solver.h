@@ -15,15 +15,16 @@
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/types.h"
+#include "rigid_body_sim/physics/union_find.h"
 
 namespace rigid_body_sim::physics {
 
 struct SolverSettings {
   // PGS sweeps over the resting-contact rows per step, at most.
   int velocity_iterations = 20;
-  // m/s; the sweeps stop early once no contact point's relative velocity
-  // changes by more than this from one sweep to the next (0: always
-  // velocity_iterations).
+  // m/s; an island's sweeps stop early once none of its contact points'
+  // relative velocities changes by more than this from one sweep to the next
+  // (0: always velocity_iterations).
   double velocity_tolerance = 1e-6;
   // Sweeps of the split-impulse position correction per step.
   int position_iterations = 6;
@@ -133,12 +134,25 @@ struct RestingRow {
 // Two runs of resting rows, each the adjacent rows of one body pair, that a
 // sweep updates side by side: [first_begin, first_end) and
 // [second_begin, second_end), the second empty when no run could join the
-// first.
+// first; with the islands the two runs belong to (a run's two bodies are in
+// one island).
 struct SweepTask {
   std::uint32_t first_begin = 0;
   std::uint32_t first_end = 0;
   std::uint32_t second_begin = 0;
   std::uint32_t second_end = 0;
+  std::uint32_t first_island = 0;
+  std::uint32_t second_island = 0;
+};
+
+// One island of the resting solve, a connected component of its rows
+// through bodies the solve moves, while its sweeps go on.
+struct RestingIsland {
+  std::uint32_t row_count = 0;
+  bool converged = false;
+  // m^2/s^2; the largest |v - v_previous sweep|^2 of its points in the
+  // current sweep.
+  double largest_change_squared = 0.0;
 };
 
 class ContactSolver {
@@ -182,12 +196,16 @@ class ContactSolver {
   // pairs that are still apart join as speculative rows with target
   // min(0, -separation/dt): the gap may close within the step, not more.
   // Then the split-impulse pseudo velocities that push penetrating contacts
-  // apart.
+  // apart. Each island of the contact graph stops sweeping on its own
+  // (FindIslands).
   void SolveRestingContacts();
 
   double time_step() const { return time_step_; }
-  // Velocity sweeps the last SolveRestingContacts ran.
+  // Velocity sweeps the last SolveRestingContacts ran on its slowest
+  // island to converge.
   int velocity_sweeps() const { return velocity_sweeps_; }
+  // Row updates of those sweeps: each island's rows times its sweeps.
+  std::size_t velocity_row_updates() const { return velocity_row_updates_; }
 
  private:
   void ApplyImpulse(const SolverManifold& manifold, const SolverPoint& point,
@@ -195,9 +213,10 @@ class ContactSolver {
   double NormalVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
+  void FindIslands();
   void ScheduleRuns();
   template <bool kPseudo>
-  double SweepSchedule();
+  void SweepSchedule();
   void ComputeMasses();
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
@@ -209,6 +228,7 @@ class ContactSolver {
   SolverSettings settings_;
   double time_step_ = 1.0;
   int velocity_sweeps_ = 0;
+  std::size_t velocity_row_updates_ = 0;
   // Whether ResolveCollisions applied impulses, so that v_r may differ from
   // Prepare's.
   bool velocities_changed_ = false;
@@ -216,6 +236,12 @@ class ContactSolver {
   std::vector<SolverManifold> manifolds_;
   std::vector<RestingRow> rows_;
   std::vector<SweepTask> schedule_;
+  std::vector<RestingIsland> islands_;
+  // Each row's island; with the rest, scratch of FindIslands kept for its
+  // memory.
+  std::vector<std::uint32_t> row_island_;
+  UnionFind island_sets_;
+  std::vector<std::uint32_t> island_of_root_;
 };
 
 }  // namespace rigid_body_sim::physics

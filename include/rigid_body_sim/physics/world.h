@@ -52,7 +52,8 @@ struct StepProfile {
   double solver_ms = 0.0;         // ms, stage 4 (collisions, forces, resting contact)
   double integrator_ms = 0.0;     // ms, stage 5
   std::size_t solver_points = 0;  // contact points handed to the solver
-  int velocity_sweeps = 0;        // Gauss-Seidel sweeps of the resting solve
+  int velocity_sweeps = 0;        // Gauss-Seidel sweeps of the resting solve's slowest island
+  std::size_t velocity_row_updates = 0;  // row updates of those sweeps, all islands
   // Manifolds carried to the new poses (contact_reuse_distance) instead of
   // clipped, in stage 2.
   std::size_t reused_manifolds = 0;
