@@ -520,11 +520,11 @@ int Main(int argc, char** argv) {
   // Stage profile and the cost of one contact row in one solver iteration.
   std::printf(
       "\nstage profile, ms per step (mean of the median run); solver ns per row-iteration "
-      "= solver time of the steps with contacts / (points x rows per point x velocity "
-      "iterations); ours: 3 rows per point (normal + 2-D friction), the sweeps each step ran "
-      "(up to 20), and its solver stage also holds the collision rounds and 6 position sweeps; "
-      "Bullet: 2 rows "
-      "per point, 10 iterations; contact s = simulated time of the steps with contact points to "
+      "= solver time of the steps with contacts / (point updates of the velocity iterations x "
+      "rows per point); ours: each island's points times the sweeps it ran (up to 20), 3 rows "
+      "per point (normal + 2-D friction), and its solver stage also holds the collision rounds "
+      "and 6 position sweeps; Bullet: points x 10 iterations, 2 rows per point; contact s = "
+      "simulated time of the steps with contact points to "
       "solve (the rest is free flight or asleep), ms/contact step = wall time of one of them\n");
   std::printf("%-11s %-6s %9s %9s %9s %9s %13s %10s %16s\n", "scene", "engine", "broad", "narrow",
               "solver", "integr", "ns/row-iter", "contact s", "ms/contact step");
