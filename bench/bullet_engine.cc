@@ -160,7 +160,6 @@ class BulletEngine : public Engine {
 
   StageTimes LastStageTimes() const override {
     StageTimes times = world_.times();
-    times.velocity_iterations = solver_iterations_;
     // The points of the manifolds the solver saw: those with an awake body.
     for (int m = 0; m < dispatcher_.getNumManifolds(); ++m) {
       const btPersistentManifold* manifold = dispatcher_.getManifoldByIndexInternal(m);

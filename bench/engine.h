@@ -19,9 +19,9 @@ struct StageTimes {
   double solver_ms = 0.0;
   double integrator_ms = 0.0;     // ours and Bullet's: integration and sleeping
   std::size_t solver_points = 0;  // contact points the solver saw
-  int velocity_iterations = 0;    // velocity sweeps of the solver in this step
-  // Point updates of those sweeps; ours sweeps each island to its own
-  // convergence, so it may update fewer than points x iterations.
+  // Point updates of the solver's velocity iterations in this step; ours
+  // sweeps each island to its own convergence, so it may update fewer than
+  // points x iterations.
   std::size_t point_iterations = 0;
 };
 

@@ -85,7 +85,6 @@ class OurEngine : public Engine {
     times.solver_ms = profile.solver_ms;
     times.integrator_ms = profile.integrator_ms;
     times.solver_points = profile.solver_points;
-    times.velocity_iterations = profile.velocity_sweeps;
     times.point_iterations = profile.velocity_row_updates;
     return times;
   }
