@@ -660,8 +660,8 @@ void ContactSolver::FindIslands() {
   row_island_.resize(rows_.size());
   islands_.clear();
   for (std::size_t r = 0; r < rows_.size(); ++r) {
-    // A row between two bodies that do not move changes nothing; it joins
-    // the island of body A.
+    // A row between two bodies that do not move changes nothing; it takes
+    // body B's set, which no row joins, so it is an island of its own rows.
     const std::uint32_t body = Moves(bodies_[rows_[r].body_a]) ? rows_[r].body_a : rows_[r].body_b;
     std::uint32_t& island = island_of_root_[island_sets_.Find(body)];
     if (island == kNone) {
