@@ -267,6 +267,8 @@ Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node) {
                 &options.world.sleep.angular_velocity),
       ReadParam(private_node, "sleep/time_to_sleep", ReadDouble,
                 &options.world.sleep.time_to_sleep),
+      ReadParam(private_node, "sleep/speeding_up_time", ReadDouble,
+                &options.world.sleep.speeding_up_time),
       ReadParam(private_node, "status_period", ReadDouble, &options.status_period),
       ReadParam(private_node, "contact_force_scale", ReadDouble, &options.contact_force_scale),
   };

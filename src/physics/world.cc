@@ -101,7 +101,8 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
   }
   const SleepSettings& sleep = settings.sleep;
   if (!(sleep.linear_velocity >= 0.0) || !(sleep.angular_velocity >= 0.0) ||
-      !(sleep.time_to_sleep >= 0.0) || !std::isfinite(sleep.time_to_sleep)) {
+      !(sleep.time_to_sleep >= 0.0) || !std::isfinite(sleep.time_to_sleep) ||
+      !(sleep.speeding_up_time >= 0.0) || !std::isfinite(sleep.speeding_up_time)) {
     return Status::Error("sleep thresholds must be finite and >= 0");
   }
   if (Status status = ValidateSolverSettings(settings.solver); !status.ok()) {

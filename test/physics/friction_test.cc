@@ -122,7 +122,11 @@ INSTANTIATE_TEST_SUITE_P(
                       InclineCase{35 * kDegree, Incline::kTiltedRamp},
                       InclineCase{kFrictionAngle - 2 * kDegree, Incline::kTiltedGravity},
                       InclineCase{kFrictionAngle + 2 * kDegree, Incline::kTiltedGravity},
-                      InclineCase{35 * kDegree, Incline::kTiltedGravity}));
+                      InclineCase{35 * kDegree, Incline::kTiltedGravity},
+                      // Slower than the sleep threshold (0.05 m/s) for its
+                      // first 1.3 s: it must not fall asleep mid-slide.
+                      InclineCase{kFrictionAngle + 0.2 * kDegree, Incline::kTiltedRamp},
+                      InclineCase{kFrictionAngle + 0.2 * kDegree, Incline::kTiltedGravity}));
 
 // A box launched along flat ground at v0 stops after v0^2 / (2 mu g).
 TEST(FrictionTest, LaunchedBoxStopsAfterAnalyticDistance) {

@@ -12,8 +12,10 @@ namespace {
 
 using testing::AddBox;
 using testing::AddGround;
+using testing::AddSphere;
 using testing::BoxSpec;
 using testing::MakeMaterial;
+using testing::SphereSpec;
 using testing::Translation;
 
 constexpr double kG = 9.81;
@@ -150,6 +152,32 @@ TEST(SleepTest, DestroyedSleepingBoxLeavesTheOthersReports) {
   EXPECT_EQ(world.AwakeBodyCount(), 0u);
   ExpectSameReports(ReportsNaming(world, kept), kept_reports);
   EXPECT_NEAR(NormalForceBetween(world, kept, ground) / (kMass * kG), 1.0, 0.01);
+}
+
+// A ball on a 0.5 degree slope rolls without slipping, x = 1/2 (5/7) g
+// sin(theta) t^2 (solid sphere, I = 2/5 m r^2). Its radius, 0.5 m, keeps it
+// slower than both sleep thresholds (0.05 m/s, 0.1 rad/s) for its first
+// 0.84 s. It gains speed at every step, so it is getting under way, not
+// settling: it must not fall asleep.
+TEST(SleepTest, BallRollingOffAGentleSlopeStaysAwake) {
+  const double theta = 0.5 * M_PI / 180.0;
+  WorldSettings settings;
+  settings.gravity = kG * Vec3(std::sin(theta), 0.0, -std::cos(theta));
+  World world(settings);
+  AddGround(&world, MakeMaterial(0.5, 0.0));
+  SphereSpec spec;
+  spec.radius = 0.5;
+  spec.world_from_body = Translation(0, 0, spec.radius);
+  spec.material = MakeMaterial(0.5, 0.0);
+  const BodyId ball = AddSphere(&world, spec);
+  const double t = 2.0;
+  for (int step = 0; step < static_cast<int>(std::lround(t / settings.time_step)); ++step) {
+    world.Step();
+  }
+  EXPECT_TRUE(world.GetBody(ball).awake);
+  const double expected = 0.5 * (5.0 / 7.0) * kG * std::sin(theta) * t * t;
+  EXPECT_NEAR(world.GetPose(ball).translation.x() / expected, 1.0, 0.01)
+      << "rolled " << world.GetPose(ball).translation.x() << " m, expected " << expected << " m";
 }
 
 }  // namespace

@@ -134,6 +134,10 @@ TEST_F(WorldInputTest, RefusesBadSettings) {
   settings.time_step = 0.01;
   settings.gravity.x() = kNaN;
   EXPECT_FALSE(world_.SetSettings(settings).ok());
+  settings = WorldSettings();
+  settings.sleep.speeding_up_time = -0.1;
+  EXPECT_FALSE(world_.SetSettings(settings).ok());
+  EXPECT_DOUBLE_EQ(world_.settings().sleep.speeding_up_time, 0.1);
 }
 
 }  // namespace

@@ -61,8 +61,13 @@ struct Body {
   bool is_static = false;
   bool awake = true;
   double sleep_time = 0.0;  // s the body has been slow enough to sleep
-  bool has_proxy = false;   // registered with the broad phase
-  bool disabled = false;    // its state became non-finite; out of the simulation
+  // s its speed (or its angular speed) has grown at every step, above the
+  // noise; with the speeds at the end of the previous step.
+  double speeding_up_time = 0.0;
+  double last_speed = 0.0;          // m/s
+  double last_angular_speed = 0.0;  // rad/s
+  bool has_proxy = false;           // registered with the broad phase
+  bool disabled = false;            // its state became non-finite; out of the simulation
   std::uint64_t user_data = 0;
   std::uint32_t generation = 0;
   bool in_use = false;

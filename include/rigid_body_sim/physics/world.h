@@ -22,6 +22,12 @@ struct SleepSettings {
   double linear_velocity = 0.05;  // m/s; slower bodies may sleep
   double angular_velocity = 0.1;  // rad/s
   double time_to_sleep = 0.5;     // s an island must stay slow before it sleeps
+  // s; a body whose speed or angular speed has grown at every step for this
+  // long is getting under way, not settling, and keeps its island awake
+  // however slow it still is: a box on a slope just steeper than its
+  // friction angle, a ball on a gentle slope. Speeds below 2 % of the
+  // thresholds above do not count. 0 disables it.
+  double speeding_up_time = 0.1;
 };
 
 struct WorldSettings {
@@ -128,6 +134,7 @@ class World {
   void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
                       const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void UpdateSleep(double dt);
+  bool UpdateSpeedingUp(double dt, Body* body) const;
   void DisableNonFiniteBodies();
   // `pairs` are the touching pairs, one per solver manifold.
   void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt);
