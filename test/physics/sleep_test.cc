@@ -180,5 +180,29 @@ TEST(SleepTest, BallRollingOffAGentleSlopeStaysAwake) {
       << "rolled " << world.GetPose(ball).translation.x() << " m, expected " << expected << " m";
 }
 
+// A unit box balanced on an edge, 1 mrad past the balance point, tips over:
+// the tilt grows as e^(k t) with k^2 = m g d / I_edge = 9.81 (sqrt(2)/2) /
+// (2/3) 1/s^2, so it turns slower than the sleep threshold, 0.1 rad/s, for
+// its first 1.3 s. Gaining speed at every step, it must not fall asleep on
+// its edge, and ends on a face.
+TEST(SleepTest, BoxTippingOffItsEdgeDoesNotFallAsleepOnIt) {
+  World world;
+  AddGround(&world, MakeMaterial(0.5, 0.0));
+  BoxSpec spec;
+  spec.material = MakeMaterial(0.5, 0.0);
+  spec.world_from_body.rotation = Quat(Eigen::AngleAxisd(M_PI / 4 + 1e-3, Vec3::UnitY()));
+  // The lowest edge on the ground: half the box's diagonal below its centre.
+  double lowest = 0.0;
+  for (const double x : {-0.5, 0.5}) {
+    for (const double z : {-0.5, 0.5}) {
+      lowest = std::min(lowest, (spec.world_from_body.rotation * Vec3(x, 0, z)).z());
+    }
+  }
+  spec.world_from_body.translation = Vec3(0, 0, -lowest);
+  const BodyId box = AddBox(&world, spec);
+  for (int step = 0; step < 240 * 3; ++step) world.Step();
+  EXPECT_NEAR(world.GetPose(box).translation.z(), 0.5, 1e-3);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::physics

@@ -25,8 +25,8 @@ struct SleepSettings {
   // s; a body whose speed or angular speed has grown at every step for this
   // long is getting under way, not settling, and keeps its island awake
   // however slow it still is: a box on a slope just steeper than its
-  // friction angle, a ball on a gentle slope. Speeds below 2 % of the
-  // thresholds above do not count. 0 disables it.
+  // friction angle, a ball on a gentle slope, a box tipping off an edge.
+  // Speeds below 2 % of the thresholds above do not count. 0 disables it.
   double speeding_up_time = 0.1;
 };
 
