@@ -50,7 +50,10 @@ struct SolverSettings {
   // PGS sweeps within one collision round.
   int collision_iterations = 30;
   // Collision rounds with at most this many points solve the compression
-  // exactly by pivoting; larger ones by PGS.
+  // exactly by pivoting; larger ones by PGS. A resting island with at most
+  // this many points that the sweeps leave unconverged (a light body under a
+  // heavy one) has its normal impulses solved by pivoting too, and is then
+  // swept again.
   int max_pivoting_points = 32;
 };
 
@@ -197,7 +200,8 @@ class ContactSolver {
   // min(0, -separation/dt): the gap may close within the step, not more.
   // Then the split-impulse pseudo velocities that push penetrating contacts
   // apart. Each island of the contact graph stops sweeping on its own
-  // (FindIslands).
+  // (FindIslands); a small one still unconverged is finished by pivoting
+  // (FinishIslandsExactly).
   void SolveRestingContacts();
 
   double time_step() const { return time_step_; }
@@ -217,6 +221,9 @@ class ContactSolver {
   void ScheduleRuns();
   template <bool kPseudo>
   void SweepSchedule();
+  void SweepUntilConverged();
+  // Returns whether it finished any island, which it then marks unconverged.
+  bool FinishIslandsExactly();
   void ComputeMasses();
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
@@ -242,6 +249,9 @@ class ContactSolver {
   std::vector<std::uint32_t> row_island_;
   UnionFind island_sets_;
   std::vector<std::uint32_t> island_of_root_;
+  // Scratch of FinishIslandsExactly, kept for its memory.
+  std::vector<std::uint32_t> exact_rows_;
+  std::vector<std::uint32_t> exact_begin_;
 };
 
 }  // namespace rigid_body_sim::physics
