@@ -88,6 +88,17 @@ inline double KineticEnergy(const Body& body) {
          0.5 * body.angular_velocity.dot(body.angular_momentum);
 }
 
+// The normal force between bodies x and y, summed over their reports, N.
+inline double NormalForceBetween(const World& world, BodyId x, BodyId y) {
+  double total = 0.0;
+  for (const ContactReport& report : world.contacts()) {
+    if ((report.body_a == x && report.body_b == y) || (report.body_a == y && report.body_b == x)) {
+      total += report.normal_force;
+    }
+  }
+  return total;
+}
+
 }  // namespace rigid_body_sim::physics::testing
 
 #endif  // RIGID_BODY_SIM_TEST_PHYSICS_SCENE_H_

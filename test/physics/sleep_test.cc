@@ -15,6 +15,7 @@ using testing::AddGround;
 using testing::AddSphere;
 using testing::BoxSpec;
 using testing::MakeMaterial;
+using testing::NormalForceBetween;
 using testing::SphereSpec;
 using testing::Translation;
 
@@ -45,17 +46,6 @@ bool StepUntilAsleep(World* world, BodyId body, double seconds) {
 
 bool Names(const ContactReport& report, BodyId body) {
   return report.body_a.index == body.index || report.body_b.index == body.index;
-}
-
-// Sum of normal_force over the reports between bodies `x` and `y`.
-double NormalForceBetween(const World& world, BodyId x, BodyId y) {
-  double total = 0.0;
-  for (const ContactReport& report : world.contacts()) {
-    if ((report.body_a == x && report.body_b == y) || (report.body_a == y && report.body_b == x)) {
-      total += report.normal_force;
-    }
-  }
-  return total;
 }
 
 std::vector<ContactReport> ReportsNaming(const World& world, BodyId body) {

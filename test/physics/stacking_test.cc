@@ -16,6 +16,7 @@ using testing::AddGround;
 using testing::BoxSpec;
 using testing::KineticEnergy;
 using testing::MakeMaterial;
+using testing::NormalForceBetween;
 using testing::Translation;
 
 double MaxDrift(World* world, BodyId id, double seconds) {
@@ -43,17 +44,6 @@ void ExpectSameMotionBitForBit(const World& world, const std::vector<BodyId>& bo
     EXPECT_EQ(world.GetAngularVelocity(boxes[i]), reference.GetAngularVelocity(reference_boxes[i]))
         << "box " << i;
   }
-}
-
-// The normal force between bodies x and y, summed over their reports, N.
-double NormalForceBetween(const World& world, BodyId x, BodyId y) {
-  double total = 0.0;
-  for (const ContactReport& report : world.contacts()) {
-    if ((report.body_a == x && report.body_b == y) || (report.body_a == y && report.body_b == x)) {
-      total += report.normal_force;
-    }
-  }
-  return total;
 }
 
 // A heavy box dropped 0.3 m onto a 1 kg box on the ground. Gauss-Seidel
