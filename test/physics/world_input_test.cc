@@ -137,7 +137,8 @@ TEST_F(WorldInputTest, RefusesBadSettings) {
   settings = WorldSettings();
   settings.sleep.speeding_up_time = -0.1;
   EXPECT_FALSE(world_.SetSettings(settings).ok());
-  EXPECT_DOUBLE_EQ(world_.settings().sleep.speeding_up_time, 0.1);
+  EXPECT_DOUBLE_EQ(world_.settings().sleep.speeding_up_time,
+                   WorldSettings().sleep.speeding_up_time);
 }
 
 }  // namespace

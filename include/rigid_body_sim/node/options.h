@@ -26,7 +26,7 @@ struct NodeOptions {
   // penetration_slop (m, 1e-4), position_correction (1/step, 0.2),
   // max_collision_rounds (32), collision_iterations (30)} and
   // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
-  // (rad/s, 0.1), time_to_sleep (s, 0.5), speeding_up_time (s, 0.1)}; see
+  // (rad/s, 0.1), time_to_sleep (s, 0.5), speeding_up_time (s, 0.2)}; see
   // physics/world.h.
   physics::WorldSettings world;
   double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
