@@ -73,6 +73,7 @@ void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
   body->pseudo_angular_velocity.setZero();
   body->awake = true;
   body->sleep_time = 0.0;
+  body->speeding_up_time = 0.0;
   body->UpdateDerived();
   body->start_linear_velocity = body->linear_velocity;
 }
@@ -300,6 +301,7 @@ void World::Wake(std::uint32_t index) {
   woke_since_prune_ |= !body.awake;
   body.awake = true;
   body.sleep_time = 0.0;
+  body.speeding_up_time = 0.0;
 }
 
 void World::WakeTouching(std::uint32_t index) {
