@@ -22,7 +22,7 @@
 #include <random>
 #include <vector>
 
-#include "rigid_body_sim/physics/broad_phase.h"
+#include "physics/broad_phase.h"
 
 namespace rigid_body_sim::physics {
 namespace {

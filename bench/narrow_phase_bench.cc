@@ -16,12 +16,11 @@
 #include <ctime>
 #include <memory>
 
-#include "rigid_body_sim/physics/narrow_phase.h"
+#include "physics/narrow_phase.h"
 
 namespace rigid_body_sim::physics {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 struct Scene {
   const char* name;

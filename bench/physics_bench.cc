@@ -50,7 +50,6 @@ namespace rigid_body_sim::bench {
 namespace {
 
 constexpr double kGravity = 9.81;  // m/s^2
-constexpr double kPi = 3.14159265358979323846;
 
 // What one run measures; plain data, sent from the child through a pipe.
 struct RunResult {

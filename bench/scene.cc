@@ -5,7 +5,6 @@
 namespace rigid_body_sim::bench {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Two unit boxes of one layer, both yawed by theta, with centres 1.1 m apart
 // along x are separated along their own x axis only while 1.1 cos(theta) >= 1,
 // i.e. theta <= 0.430 rad (along their y axis, 1.1 sin(theta) < 1 for these

@@ -9,6 +9,7 @@
 
 namespace rigid_body_sim::bench {
 
+using physics::kPi;
 using physics::Pose;
 using physics::Quat;
 using physics::Vec3;

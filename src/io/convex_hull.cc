@@ -211,9 +211,8 @@ physics::Status CheckNotDegenerate(const std::vector<Vec3>& points, double toler
 // of directions, which keeps this O(N * directions) pass memory-friendly.
 std::vector<int> LatticeSupports(const std::vector<Vec3>& points,
                                  const std::vector<int>& candidates, int direction_count) {
-  constexpr double kPi = 3.14159265358979323846;
   constexpr int kBlock = 4;
-  const double golden_angle = kPi * (3.0 - std::sqrt(5.0));
+  const double golden_angle = physics::kPi * (3.0 - std::sqrt(5.0));
   const size_t count = candidates.size();
   std::vector<double> xs(count);
   std::vector<double> ys(count);

@@ -25,6 +25,7 @@ using physics::MassProperties;
 using physics::Mat3;
 using physics::Pose;
 using physics::Quat;
+using physics::FormatNumber;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;
@@ -32,12 +33,6 @@ using physics::Vec3;
 constexpr char kWorldLink[] = "world";
 
 std::string Quoted(const std::string& text) { return "'" + text + "'"; }
-
-std::string FormatNumber(double value) {
-  std::ostringstream stream;
-  stream << value;
-  return stream.str();
-}
 
 // urdfdom reports why it rejects a document through console_bridge. While a
 // document is parsed, its messages are collected here so they can go into

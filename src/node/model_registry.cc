@@ -10,6 +10,7 @@ namespace rigid_body_sim::node {
 
 using physics::BodyDef;
 using physics::Pose;
+using physics::FormatNumber;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;
@@ -19,12 +20,6 @@ namespace {
 bool IsNameStart(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; }
 bool IsNameChar(char c) { return IsNameStart(c) || (c >= '0' && c <= '9'); }
 
-std::string Number(double value) {
-  std::ostringstream stream;
-  stream << value;
-  return stream.str();
-}
-
 }  // namespace
 
 Status ValidateModelName(const std::string& name) {
@@ -32,7 +27,7 @@ Status ValidateModelName(const std::string& name) {
   for (std::size_t i = 0; i < name.size(); ++i) {
     const char c = name[i];
     if (i == 0 ? !IsNameStart(c) : !IsNameChar(c)) {
-      std::string shown = (c >= 0x20 && c < 0x7f) ? std::string(1, c) : "\\x" + Number(int(c));
+      std::string shown = (c >= 0x20 && c < 0x7f) ? std::string(1, c) : "\\x" + FormatNumber(int(c));
       return Status::Error("model name '" + name + "' has a bad character '" + shown +
                            "' at position " + std::to_string(i) +
                            "; names match [A-Za-z_][A-Za-z0-9_]*");
@@ -52,7 +47,7 @@ Result<BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
     return Result<BodyDef>::Error("friction is infinite");
   }
   if (spec.restitution > 1.0) {
-    return Result<BodyDef>::Error("restitution " + Number(spec.restitution) + " is outside [0, 1]");
+    return Result<BodyDef>::Error("restitution " + FormatNumber(spec.restitution) + " is outside [0, 1]");
   }
   BodyDef def;
   def.is_static = spec.is_static || model.is_static;

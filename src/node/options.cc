@@ -8,17 +8,12 @@
 
 namespace rigid_body_sim::node {
 
+using physics::FormatNumber;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;
 
 namespace {
-
-std::string Number(double value) {
-  std::ostringstream stream;
-  stream << value;
-  return stream.str();
-}
 
 bool IsNumber(const XmlRpc::XmlRpcValue& value) {
   return value.getType() == XmlRpc::XmlRpcValue::TypeDouble ||
@@ -147,7 +142,7 @@ Status ValidateNodeOptions(const NodeOptions& options) {
   }
   if (!physics::IsFinite(options.world.gravity)) return Status::Error("~gravity is not finite");
   if (!(options.world.time_step > 0.0) || !std::isfinite(options.world.time_step)) {
-    return Status::Error("~time_step " + Number(options.world.time_step) +
+    return Status::Error("~time_step " + FormatNumber(options.world.time_step) +
                          " s must be positive and finite");
   }
   if (Status status = physics::ValidateWorldSettings(options.world); !status.ok()) {
@@ -157,21 +152,21 @@ Status ValidateNodeOptions(const NodeOptions& options) {
         status.message());
   }
   if (!(options.real_time_factor >= 0.0) || !std::isfinite(options.real_time_factor)) {
-    return Status::Error("~real_time_factor " + Number(options.real_time_factor) +
+    return Status::Error("~real_time_factor " + FormatNumber(options.real_time_factor) +
                          " must be >= 0 (0: as fast as possible)");
   }
   if (!(options.publish_rate > 0.0) || !std::isfinite(options.publish_rate)) {
-    return Status::Error("~publish_rate " + Number(options.publish_rate) + " Hz must be positive");
+    return Status::Error("~publish_rate " + FormatNumber(options.publish_rate) + " Hz must be positive");
   }
   const auto check_friction = [](double value, const std::string& name) {
     return value >= 0.0 && std::isfinite(value)
                ? Status::Ok()
-               : Status::Error(name + " " + Number(value) + " must be >= 0");
+               : Status::Error(name + " " + FormatNumber(value) + " must be >= 0");
   };
   const auto check_restitution = [](double value, const std::string& name) {
     return value >= 0.0 && value <= 1.0
                ? Status::Ok()
-               : Status::Error(name + " " + Number(value) + " must be in [0, 1]");
+               : Status::Error(name + " " + FormatNumber(value) + " must be in [0, 1]");
   };
   for (const Status& status :
        {check_friction(options.ground_friction, "~ground_friction"),
@@ -181,7 +176,7 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     if (!status.ok()) return status;
   }
   if (!(options.default_density > 0.0) || !std::isfinite(options.default_density)) {
-    return Status::Error("~default_density " + Number(options.default_density) +
+    return Status::Error("~default_density " + FormatNumber(options.default_density) +
                          " kg/m^3 must be positive");
   }
   if (options.max_hull_vertices < 4) {
@@ -193,10 +188,10 @@ Status ValidateNodeOptions(const NodeOptions& options) {
                          " must be >= 3");
   }
   if (!(options.status_period > 0.0) || !std::isfinite(options.status_period)) {
-    return Status::Error("~status_period " + Number(options.status_period) + " s must be positive");
+    return Status::Error("~status_period " + FormatNumber(options.status_period) + " s must be positive");
   }
   if (!(options.contact_force_scale > 0.0) || !std::isfinite(options.contact_force_scale)) {
-    return Status::Error("~contact_force_scale " + Number(options.contact_force_scale) +
+    return Status::Error("~contact_force_scale " + FormatNumber(options.contact_force_scale) +
                          " m/N must be positive");
   }
   std::set<std::string> model_names;

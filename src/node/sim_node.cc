@@ -15,6 +15,7 @@ namespace rigid_body_sim::node {
 
 using physics::BodyId;
 using physics::Pose;
+using physics::FormatNumber;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;
@@ -28,12 +29,6 @@ constexpr double kMaxLagSeconds = 0.1;
 constexpr double kClockPeriodSeconds = 0.001;
 constexpr char kPackageScheme[] = "package://";
 constexpr char kFileScheme[] = "file://";
-
-std::string Number(double value) {
-  std::ostringstream stream;
-  stream << value;
-  return stream.str();
-}
 
 bool StartsWith(const std::string& text, const std::string& prefix) {
   return text.compare(0, prefix.size(), prefix) == 0;
@@ -405,7 +400,7 @@ bool SimNode::OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
   Result<Vec3> torque = VectorFromMsg(request.wrench.torque, "wrench.torque");
   if (!torque.ok()) return Fail(response, torque.message(), service);
   if (!(request.duration >= 0.0) || !std::isfinite(request.duration)) {
-    return Fail(response, "duration " + Number(request.duration) + " s must be >= 0 and finite",
+    return Fail(response, "duration " + FormatNumber(request.duration) + " s must be >= 0 and finite",
                 service);
   }
   std::unique_lock<std::mutex> lock = LockWorld();
@@ -439,12 +434,12 @@ bool SimNode::OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
   Result<Vec3> gravity = VectorFromMsg(request.gravity, "gravity");
   if (!gravity.ok()) return Fail(response, gravity.message(), service);
   if (!(request.time_step > 0.0) || !std::isfinite(request.time_step)) {
-    return Fail(response, "time_step " + Number(request.time_step) + " s must be positive",
+    return Fail(response, "time_step " + FormatNumber(request.time_step) + " s must be positive",
                 service);
   }
   if (!(request.real_time_factor >= 0.0) || !std::isfinite(request.real_time_factor)) {
     return Fail(response,
-                "real_time_factor " + Number(request.real_time_factor) +
+                "real_time_factor " + FormatNumber(request.real_time_factor) +
                     " must be >= 0 (0: as fast as possible)",
                 service);
   }

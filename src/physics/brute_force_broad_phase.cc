@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/broad_phase.h"
+#include "physics/broad_phase.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/contact_cache.h"
+#include "physics/contact_cache.h"
 
 #include <algorithm>
 #include <cassert>

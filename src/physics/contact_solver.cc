@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/contact_solver.h"
+#include "physics/contact_solver.h"
 
 #include <algorithm>
 #include <cassert>
@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "rigid_body_sim/physics/lcp.h"
+#include "physics/lcp.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -59,30 +59,6 @@ void ClampToDisc(double limit, std::array<double, 2>* tangent) {
 }
 
 }  // namespace
-
-Status ValidateSolverSettings(const SolverSettings& settings) {
-  if (settings.velocity_iterations < 1) return Status::Error("velocity_iterations must be >= 1");
-  if (settings.position_iterations < 0) return Status::Error("position_iterations must be >= 0");
-  if (!(settings.velocity_tolerance >= 0.0) || !std::isfinite(settings.velocity_tolerance)) {
-    return Status::Error("velocity_tolerance must be finite and >= 0");
-  }
-  if (!(settings.collision_velocity_threshold >= 0.0) ||
-      !std::isfinite(settings.collision_velocity_threshold)) {
-    return Status::Error("collision_velocity_threshold must be finite and >= 0");
-  }
-  if (!(settings.contact_tolerance > 0.0) || !std::isfinite(settings.contact_tolerance)) {
-    return Status::Error("contact_tolerance must be finite and > 0");
-  }
-  if (!(settings.penetration_slop >= 0.0) || !std::isfinite(settings.penetration_slop)) {
-    return Status::Error("penetration_slop must be finite and >= 0");
-  }
-  if (!(settings.position_correction > 0.0 && settings.position_correction <= 1.0)) {
-    return Status::Error("position_correction must be in (0, 1]");
-  }
-  if (settings.max_collision_rounds < 1) return Status::Error("max_collision_rounds must be >= 1");
-  if (settings.collision_iterations < 1) return Status::Error("collision_iterations must be >= 1");
-  return Status::Ok();
-}
 
 std::array<Vec3, 2> TangentBasis(const Vec3& normal) {
   const Vec3 helper = std::abs(normal.x()) < 0.57 ? Vec3::UnitX() : Vec3::UnitY();

@@ -14,8 +14,6 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Tolerances relative to the bounding-box diagonal of the input (`scale`):
 // Neighbouring faces whose vertices all lie within this distance of each
 // other's plane are one face. Multiplied by the face size this is an angle

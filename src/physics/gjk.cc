@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/gjk.h"
+#include "physics/gjk.h"
 
 #include <algorithm>
 #include <cassert>

@@ -15,7 +15,7 @@
 //    motion is kept; RK4 keeps the kinetic energy drift at O(dt^4). A body
 //    with isotropic inertia spins at constant omega and is rotated exactly.
 //  * q is renormalised after every step.
-#include "rigid_body_sim/physics/integrator.h"
+#include "physics/integrator.h"
 
 #include <cassert>
 

@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/lcp.h"
+#include "physics/lcp.h"
 
 #include <algorithm>
 #include <cassert>

@@ -14,7 +14,6 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // |volume| below this fraction of (bounding-box diagonal)^3 counts as zero:
 // such a mesh is flat or self-cancelling, and its inertia would be noise.
 constexpr double kRelativeVolumeTolerance = 1e-12;

@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/narrow_phase.h"
+#include "physics/narrow_phase.h"
 
 #include <algorithm>
 #include <cassert>

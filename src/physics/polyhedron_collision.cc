@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/polyhedron_collision.h"
+#include "physics/polyhedron_collision.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/shape_bounds.h"
+#include "physics/shape_bounds.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,9 +1,9 @@
-// Stage 1 of World::Step: every body's swept, fattened box goes to the
+// Stage 1 of WorldImpl::Step: every body's swept, fattened box goes to the
 // sort-and-sweep broad phase, which returns the candidate pairs.
 #include <variant>
 
-#include "rigid_body_sim/physics/shape_bounds.h"
-#include "rigid_body_sim/physics/world.h"
+#include "physics/shape_bounds.h"
+#include "physics/world_impl.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -26,7 +26,7 @@ ProxyKind KindOf(const Body& body) {
 
 }  // namespace
 
-void World::UpdateBroadPhase(double dt) {
+void WorldImpl::UpdateBroadPhase(double dt) {
   const double margin = settings_.contact_margin;
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& body = bodies_[i];

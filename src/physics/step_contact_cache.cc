@@ -1,11 +1,11 @@
-// Stage 3 of World::Step: match this step's contact points with last step's
+// Stage 3 of WorldImpl::Step: match this step's contact points with last step's
 // for warm starting, forget vanished pairs, and wake sleeping bodies that an
 // awake body touches.
-#include "rigid_body_sim/physics/world.h"
+#include "physics/world_impl.h"
 
 namespace rigid_body_sim::physics {
 
-void World::UpdateContactCache() {
+void WorldImpl::UpdateContactCache() {
   contact_cache_.MatchAndPrune(step_count_, woke_since_prune_,
                                [this](const ShapePairContact& pair) {
                                  const Body& a = bodies_[pair.body_a];

@@ -1,14 +1,14 @@
-// Stage 5 of World::Step: drift the bodies, back up the ones that would
+// Stage 5 of WorldImpl::Step: drift the bodies, back up the ones that would
 // enter another body to their time of impact, and put quiet islands to sleep.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <variant>
 
-#include "rigid_body_sim/physics/integrator.h"
-#include "rigid_body_sim/physics/narrow_phase.h"
-#include "rigid_body_sim/physics/union_find.h"
-#include "rigid_body_sim/physics/world.h"
+#include "physics/integrator.h"
+#include "physics/narrow_phase.h"
+#include "physics/union_find.h"
+#include "physics/world_impl.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -31,7 +31,7 @@ constexpr double kMaxPathSamples = 1e4;
 // of its thickness per step is first sampled along its path, so that a thin
 // wall it would pass through entirely still shows a penetrating sample to
 // bracket. Pairs that cannot close their gap within the step are skipped.
-void World::IntegrateBodies(double dt) {
+void WorldImpl::IntegrateBodies(double dt) {
   // Kept between steps, so that a step neither allocates nor clears a path
   // per body: outside this function every entry reads as a body that does
   // not move (dt 0, not fast, reach 0), whatever its other fields hold.
@@ -231,7 +231,7 @@ void World::IntegrateBodies(double dt) {
 }
 
 // Only moving bodies change state within a step, so only they are checked.
-void World::DisableNonFiniteBodies() {
+void WorldImpl::DisableNonFiniteBodies() {
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
     if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
@@ -255,7 +255,7 @@ void World::DisableNonFiniteBodies() {
 // below 2 % of the sleep thresholds are noise: the residual velocities of a
 // stack at rest can grow steadily without going anywhere, and counted, they
 // kept the benchmark's pyramids awake.
-bool World::UpdateSpeedingUp(double dt, Body* body) const {
+bool WorldImpl::UpdateSpeedingUp(double dt, Body* body) const {
   constexpr double kNoiseFraction = 0.02;
   const SleepSettings& sleep = settings_.sleep;
   const double speed = body->linear_velocity.norm();
@@ -274,7 +274,7 @@ bool World::UpdateSpeedingUp(double dt, Body* body) const {
 // bodies (union-find). An island sleeps when every body in it has been slower
 // than the thresholds, and not speeding up, for time_to_sleep; it costs
 // nothing until woken.
-void World::UpdateSleep(double dt) {
+void WorldImpl::UpdateSleep(double dt) {
   const SleepSettings& sleep = settings_.sleep;
   if (!sleep.enabled) return;
   UnionFind islands(bodies_.size());

@@ -1,12 +1,12 @@
-// Stage 2 of World::Step: a contact manifold for every pair of shapes of the
+// Stage 2 of WorldImpl::Step: a contact manifold for every pair of shapes of the
 // candidate body pairs, each starting from its cached separating witness.
 #include <algorithm>
 #include <limits>
 #include <variant>
 
-#include "rigid_body_sim/physics/narrow_phase.h"
-#include "rigid_body_sim/physics/shape_bounds.h"
-#include "rigid_body_sim/physics/world.h"
+#include "physics/narrow_phase.h"
+#include "physics/shape_bounds.h"
+#include "physics/world_impl.h"
 
 namespace rigid_body_sim::physics {
 
@@ -26,7 +26,7 @@ void MovingBodyFirst(const std::vector<Body>& bodies, std::uint32_t* body_a,
 
 }  // namespace
 
-void World::UpdateNarrowPhase(double dt) {
+void WorldImpl::UpdateNarrowPhase(double dt) {
   ++step_count_;
   last_step_profile_.reused_manifolds = 0;
   const std::vector<ProxyPair>& pairs = broad_phase_.Pairs();
@@ -65,7 +65,7 @@ void World::UpdateNarrowPhase(double dt) {
 }
 
 // m; the margin plus the distance the two bodies can close in one step.
-double World::ContactDistance(const Body& a, const Body& b, double dt) const {
+double WorldImpl::ContactDistance(const Body& a, const Body& b, double dt) const {
   const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
                                a.angular_velocity.norm() * a.bounding_radius +
                                b.angular_velocity.norm() * b.bounding_radius;
@@ -81,8 +81,8 @@ double World::ContactDistance(const Body& a, const Body& b, double dt) const {
 // the vertex to the face's plane, so resting contact sees exact gaps; only
 // where clipping would put the points is off, by at most the motion bound
 // |dt| + angle r_a (reuse_error).
-bool World::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
-                          const Pose& world_from_shape_b, ShapePairContact* entry) const {
+bool WorldImpl::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
+                              const Pose& world_from_shape_b, ShapePairContact* entry) const {
   const ManifoldAnchors& anchors = entry->anchors;
   if (!anchors.valid || settings_.contact_reuse_distance <= 0.0) return false;
   const double motion = (b_from_a.translation - anchors.b_from_a.translation).norm() +
@@ -107,8 +107,8 @@ bool World::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& worl
 // Records the anchors of a manifold just clipped between two polyhedra with
 // a face witness; edge/edge manifolds, spheres and half-spaces are made
 // afresh every step.
-void World::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
-                           const Pose& world_from_shape_b, ShapePairContact* entry) const {
+void WorldImpl::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
+                               const Pose& world_from_shape_b, ShapePairContact* entry) const {
   ManifoldAnchors& anchors = entry->anchors;
   const ContactManifold& manifold = entry->manifold;
   const SeparatingWitness::Type type = entry->witness.type;
@@ -138,7 +138,7 @@ void World::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
 // have travelled less than g minus the contact distance since: no point of
 // either has moved far enough to bring them within it (conservative
 // advancement's bound, kept across steps).
-void World::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
+void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
   MovingBodyFirst(bodies_, &body_a, &body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];

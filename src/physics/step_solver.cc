@@ -1,11 +1,11 @@
-// Stage 4 of World::Step, in Baraff's order: colliding contacts get impulses
+// Stage 4 of WorldImpl::Step, in Baraff's order: colliding contacts get impulses
 // on the velocities the step starts with; then gravity and the applied
 // forces act; then resting contacts get the impulses that keep them apart.
 #include <algorithm>
 #include <cmath>
 
-#include "rigid_body_sim/physics/integrator.h"
-#include "rigid_body_sim/physics/world.h"
+#include "physics/integrator.h"
+#include "physics/world_impl.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -57,8 +57,8 @@ void StoreVelocities(const std::vector<SolverBody>& solver_bodies,
 // A resting report of point i of a pair from its cached impulses, with
 // `tangent` the basis of its normal (TangentBasis) that they are in; the
 // solver overwrites what it knows better for the pairs it solved.
-ContactReport World::MakeReport(const ShapePairContact& pair, int i,
-                                const std::array<Vec3, 2>& tangent, double dt) const {
+ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
+                                    const std::array<Vec3, 2>& tangent, double dt) const {
   const ContactPoint& contact = pair.manifold.points[i];
   const CachedImpulse& impulse = pair.previous[i];
   ContactReport report;
@@ -89,7 +89,7 @@ ContactReport World::MakeReport(const ShapePairContact& pair, int i,
 // sags and rocks for its first tenth of a second. The estimate is only
 // where the iteration starts: the complementarity conditions, and so the
 // solution, are the same.
-void World::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt) {
+void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt) {
   const double g = settings_.gravity.norm();
   if (g <= 0.0) return;
   const Vec3 up = -settings_.gravity / g;
@@ -169,7 +169,7 @@ void World::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, dou
   }
 }
 
-void World::SolveContacts(double dt) {
+void WorldImpl::SolveContacts(double dt) {
   // The bodies that move this step; the stages from here on visit only
   // them, so sleeping bodies cost nothing.
   moving_bodies_.clear();

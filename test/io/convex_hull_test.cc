@@ -18,9 +18,9 @@ namespace rigid_body_sim::io {
 namespace {
 
 using physics::ConvexPolyhedron;
+using physics::kPi;
 using physics::Vec3;
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::set<std::array<double, 3>> AsSet(const std::vector<Vec3>& points) {
   std::set<std::array<double, 3>> set;

@@ -18,6 +18,7 @@ namespace rigid_body_sim::io {
 namespace {
 
 using physics::ConvexPolyhedron;
+using physics::kPi;
 using physics::MassProperties;
 using physics::Mat3;
 using physics::Pose;
@@ -25,7 +26,6 @@ using physics::Quat;
 using physics::Result;
 using physics::Vec3;
 
-constexpr double kPi = 3.14159265358979323846;
 const std::string kDataDir = RBS_TEST_DATA_DIR;
 
 // The chamfered box of test/data/make_test_meshes.py.

@@ -1,4 +1,4 @@
-#include "rigid_body_sim/physics/broad_phase.h"
+#include "physics/broad_phase.h"
 
 #include <cmath>
 #include <limits>
@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rigid_body_sim/physics/aabb.h"
+#include "physics/aabb.h"
 
 namespace rigid_body_sim::physics {
 namespace {

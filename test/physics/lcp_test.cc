@@ -6,7 +6,7 @@
 
 #include <Eigen/Dense>
 
-#include "rigid_body_sim/physics/lcp.h"
+#include "physics/lcp.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::physics {

@@ -18,7 +18,6 @@ using testing::BoxMesh;
 using testing::CylinderMesh;
 using testing::Contains;
 using testing::Icosphere;
-using testing::kPi;
 using testing::PrismMassProperties;
 using testing::RelativeDifference;
 

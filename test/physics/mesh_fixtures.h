@@ -16,7 +16,6 @@
 
 namespace rigid_body_sim::physics::testing {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Makes every triangle counter-clockwise seen from outside, for a convex
 // mesh containing the origin: there the outward normal n of a face

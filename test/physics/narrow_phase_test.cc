@@ -1,6 +1,6 @@
 // Narrow phase: box-box manifolds, sphere cases and half-spaces against
 // analytic contact points, the witness cache, and GJK distances.
-#include "rigid_body_sim/physics/narrow_phase.h"
+#include "physics/narrow_phase.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,13 +13,12 @@
 #include <gtest/gtest.h>
 
 #include "rigid_body_sim/physics/convex_polyhedron.h"
-#include "rigid_body_sim/physics/gjk.h"
-#include "rigid_body_sim/physics/polyhedron_collision.h"
+#include "physics/gjk.h"
+#include "physics/polyhedron_collision.h"
 
 namespace rigid_body_sim::physics {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kExact = 1e-9;  // m: exact geometry up to rounding
 
 ShapeGeometry Box(const Vec3& size) {

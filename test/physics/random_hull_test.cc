@@ -17,9 +17,9 @@
 #include <gtest/gtest.h>
 
 #include "rigid_body_sim/physics/convex_polyhedron.h"
-#include "rigid_body_sim/physics/gjk.h"
-#include "rigid_body_sim/physics/narrow_phase.h"
-#include "rigid_body_sim/physics/polyhedron_collision.h"
+#include "physics/gjk.h"
+#include "physics/narrow_phase.h"
+#include "physics/polyhedron_collision.h"
 
 namespace rigid_body_sim::physics {
 namespace {

@@ -5,10 +5,19 @@
 
 #include <cassert>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 
 namespace rigid_body_sim::physics {
+
+// A number as error messages show it: the shortest of fixed or scientific
+// notation at 6 significant digits, as std::ostream prints it.
+inline std::string FormatNumber(double value) {
+  std::ostringstream stream;
+  stream << value;
+  return stream.str();
+}
 
 class Status {
  public:

@@ -11,6 +11,8 @@
 
 namespace rigid_body_sim::physics {
 
+inline constexpr double kPi = 3.14159265358979323846;
+
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Quat = Eigen::Quaterniond;

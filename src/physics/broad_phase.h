@@ -14,7 +14,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "rigid_body_sim/physics/aabb.h"
+#include "physics/aabb.h"
 #include "rigid_body_sim/physics/result.h"
 
 namespace rigid_body_sim::physics {

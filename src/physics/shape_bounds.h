@@ -3,7 +3,7 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_SHAPE_BOUNDS_H_
 #define RIGID_BODY_SIM_PHYSICS_SHAPE_BOUNDS_H_
 
-#include "rigid_body_sim/physics/aabb.h"
+#include "physics/aabb.h"
 #include "rigid_body_sim/physics/shape.h"
 #include "rigid_body_sim/physics/types.h"
 

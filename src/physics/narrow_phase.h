@@ -2,8 +2,8 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_NARROW_PHASE_H_
 #define RIGID_BODY_SIM_PHYSICS_NARROW_PHASE_H_
 
-#include "rigid_body_sim/physics/contact.h"
-#include "rigid_body_sim/physics/polyhedron_collision.h"
+#include "physics/contact_manifold.h"
+#include "physics/polyhedron_collision.h"
 #include "rigid_body_sim/physics/shape.h"
 #include "rigid_body_sim/physics/types.h"
 

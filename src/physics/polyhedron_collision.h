@@ -4,7 +4,7 @@
 
 #include <limits>
 
-#include "rigid_body_sim/physics/contact.h"
+#include "physics/contact_manifold.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
 #include "rigid_body_sim/physics/types.h"
 

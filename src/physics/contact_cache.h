@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "rigid_body_sim/physics/contact.h"
-#include "rigid_body_sim/physics/pair_index.h"
+#include "physics/contact_manifold.h"
+#include "physics/pair_index.h"
 
 namespace rigid_body_sim::physics {
 

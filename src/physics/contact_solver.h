@@ -12,52 +12,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "physics/contact_manifold.h"
+#include "physics/union_find.h"
 #include "rigid_body_sim/physics/body.h"
-#include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/types.h"
-#include "rigid_body_sim/physics/union_find.h"
+#include "rigid_body_sim/physics/world_settings.h"
 
 namespace rigid_body_sim::physics {
-
-struct SolverSettings {
-  // PGS sweeps over the resting-contact rows per step, at most.
-  int velocity_iterations = 20;
-  // m/s; an island's sweeps stop early once none of its contact points'
-  // relative velocities changes by more than this from one sweep to the next
-  // (0: always velocity_iterations).
-  double velocity_tolerance = 1e-6;
-  // Sweeps of the split-impulse position correction per step.
-  int position_iterations = 6;
-  // Whether a sweep updates two runs of rows that share no moving body side
-  // by side (ScheduleRuns), which gives bit for bit the result of updating
-  // one run at a time in manifold order (false, the reference) in less time.
-  bool interleave_independent_runs = true;
-  // m/s; epsilon of the classification: colliding when v_r < -epsilon,
-  // resting when |v_r| <= epsilon.
-  double collision_velocity_threshold = 0.01;
-  // m; points closer than this are touching (the seed's numerical
-  // tolerance): only they collide or rest. Closer points are reached by the
-  // time-of-impact search, so the approach speed, and the bounce, is exact.
-  double contact_tolerance = 1e-5;
-  // m; penetration left alone, so resting contacts persist from step to step.
-  double penetration_slop = 1e-4;
-  // 1/step, in (0, 1]; fraction of the penetration beyond the slop removed per
-  // step by the split impulse. It moves positions only and adds no energy.
-  double position_correction = 0.2;
-  // Rounds of simultaneous collision impulses before the remaining colliding
-  // contacts are made perfectly inelastic.
-  int max_collision_rounds = 32;
-  // PGS sweeps within one collision round.
-  int collision_iterations = 30;
-  // Collision rounds with at most this many points solve the compression
-  // exactly by pivoting; larger ones by PGS. A resting island with at most
-  // this many points that the sweeps leave unconverged (a light body under a
-  // heavy one) has its normal impulses solved by pivoting too, and is then
-  // swept again.
-  int max_pivoting_points = 32;
-};
-
-Status ValidateSolverSettings(const SolverSettings& settings);
 
 // Velocities and inverse inertia of one body during the solve. Static and
 // sleeping bodies have zero inverse mass and inertia.

@@ -1,0 +1,106 @@
+// Settings of a World, with their units and ranges, and the per-stage
+// timing of its last step.
+#ifndef RIGID_BODY_SIM_PHYSICS_WORLD_SETTINGS_H_
+#define RIGID_BODY_SIM_PHYSICS_WORLD_SETTINGS_H_
+
+#include <cstddef>
+
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+struct SolverSettings {
+  // PGS sweeps over the resting-contact rows per step, at most.
+  int velocity_iterations = 20;
+  // m/s; an island's sweeps stop early once none of its contact points'
+  // relative velocities changes by more than this from one sweep to the next
+  // (0: always velocity_iterations).
+  double velocity_tolerance = 1e-6;
+  // Sweeps of the split-impulse position correction per step.
+  int position_iterations = 6;
+  // Whether a sweep updates two runs of rows that share no moving body side
+  // by side (ScheduleRuns), which gives bit for bit the result of updating
+  // one run at a time in manifold order (false, the reference) in less time.
+  bool interleave_independent_runs = true;
+  // m/s; epsilon of the classification: colliding when v_r < -epsilon,
+  // resting when |v_r| <= epsilon.
+  double collision_velocity_threshold = 0.01;
+  // m; points closer than this are touching (the seed's numerical
+  // tolerance): only they collide or rest. Closer points are reached by the
+  // time-of-impact search, so the approach speed, and the bounce, is exact.
+  double contact_tolerance = 1e-5;
+  // m; penetration left alone, so resting contacts persist from step to step.
+  double penetration_slop = 1e-4;
+  // 1/step, in (0, 1]; fraction of the penetration beyond the slop removed per
+  // step by the split impulse. It moves positions only and adds no energy.
+  double position_correction = 0.2;
+  // Rounds of simultaneous collision impulses before the remaining colliding
+  // contacts are made perfectly inelastic.
+  int max_collision_rounds = 32;
+  // PGS sweeps within one collision round.
+  int collision_iterations = 30;
+  // Collision rounds with at most this many points solve the compression
+  // exactly by pivoting; larger ones by PGS. A resting island with at most
+  // this many points that the sweeps leave unconverged (a light body under a
+  // heavy one) has its normal impulses solved by pivoting too, and is then
+  // swept again.
+  int max_pivoting_points = 32;
+};
+
+Status ValidateSolverSettings(const SolverSettings& settings);
+
+struct SleepSettings {
+  bool enabled = true;
+  double linear_velocity = 0.05;  // m/s; slower bodies may sleep
+  double angular_velocity = 0.1;  // rad/s
+  double time_to_sleep = 0.5;     // s an island must stay slow before it sleeps
+  // s; a body whose speed or angular speed has grown at every step for this
+  // long is getting under way, not settling, and keeps its island awake
+  // however slow it still is: a box on a slope just steeper than its
+  // friction angle, a ball on a gentle slope, a box tipping off an edge.
+  // Speeds below 2 % of the thresholds above do not count. Long enough that
+  // the slow sway of a large stack settling is not taken for it (in the
+  // benchmark's 4,095-box pyramid a box's speed rises for up to 0.11 s).
+  // 0 disables it.
+  double speeding_up_time = 0.2;
+};
+
+struct WorldSettings {
+  Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
+  double time_step = 1.0 / 240.0;        // s, > 0
+  // m; bounding boxes are fattened by this, and contact points are reported
+  // while the surfaces are closer than this plus the pair's motion in a step.
+  double contact_margin = 0.005;
+  // A body moving more than this fraction of its thickness in one step is
+  // sampled along its path, so it cannot pass through anything (0, 1].
+  double continuous_fraction = 0.25;
+  // m; a manifold between two polyhedra is carried along with the bodies
+  // instead of clipped again while their relative motion since it was
+  // clipped moves no point by more than this (0: clip every step).
+  double contact_reuse_distance = 1e-3;
+  SolverSettings solver;
+  SleepSettings sleep;
+};
+
+Status ValidateWorldSettings(const WorldSettings& settings);
+
+// Wall-clock time of each stage of the last World::Step, for profiling; the
+// stages are the ones listed in World's private section.
+struct StepProfile {
+  double broad_phase_ms = 0.0;    // ms, stage 1
+  double narrow_phase_ms = 0.0;   // ms, stage 2
+  double contact_cache_ms = 0.0;  // ms, stage 3
+  double solver_ms = 0.0;         // ms, stage 4 (collisions, forces, resting contact)
+  double integrator_ms = 0.0;     // ms, stage 5
+  std::size_t solver_points = 0;  // contact points handed to the solver
+  int velocity_sweeps = 0;        // Gauss-Seidel sweeps of the resting solve's slowest island
+  std::size_t velocity_row_updates = 0;  // row updates of those sweeps, all islands
+  // Manifolds carried to the new poses (contact_reuse_distance) instead of
+  // clipped, in stage 2.
+  std::size_t reused_manifolds = 0;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_WORLD_SETTINGS_H_

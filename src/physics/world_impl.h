@@ -1,0 +1,105 @@
+// The implementation behind World (world.h), which forwards every call here,
+// so that the public header shows none of the stages' state. Its methods are
+// defined in world_impl.cc (bodies and state) and in one file per stage of
+// Step (step_*.cc).
+#ifndef RIGID_BODY_SIM_PHYSICS_WORLD_IMPL_H_
+#define RIGID_BODY_SIM_PHYSICS_WORLD_IMPL_H_
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "physics/broad_phase.h"
+#include "physics/contact_cache.h"
+#include "physics/contact_solver.h"
+#include "physics/integrator.h"
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+#include "rigid_body_sim/physics/world_settings.h"
+
+namespace rigid_body_sim::physics {
+
+// The public methods do what World's of the same name are documented to do.
+class WorldImpl {
+ public:
+  explicit WorldImpl(const WorldSettings& settings);
+
+  const WorldSettings& settings() const { return settings_; }
+  Status SetSettings(const WorldSettings& settings);
+  Result<BodyId> CreateBody(const BodyDef& def);
+  Status DestroyBody(BodyId id);
+  bool IsValid(BodyId id) const;
+  std::size_t BodyCount() const { return body_count_; }
+  std::size_t AwakeBodyCount() const;
+  Pose GetPose(BodyId id) const;
+  Vec3 GetLinearVelocity(BodyId id) const;
+  Vec3 GetAngularVelocity(BodyId id) const;
+  Status SetState(BodyId id, const Pose& world_from_body, const Vec3& linear_velocity,
+                  const Vec3& angular_velocity);
+  const Body& GetBody(BodyId id) const;
+  Status ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Vec3& point_world);
+  Status ApplyTorque(BodyId id, const Vec3& torque_world);
+  void Step();
+  double time() const { return time_; }
+  const StepProfile& last_step_profile() const { return last_step_profile_; }
+  void Restart();
+  const std::vector<BodyId>& non_finite_bodies() const { return non_finite_bodies_; }
+  const std::vector<ContactReport>& contacts() const { return contacts_; }
+  std::vector<ContactReport> TakeCollisionLog();
+
+ private:
+  Body& MutableBody(BodyId id);
+  void Wake(std::uint32_t body);
+  // Wakes every body that touched `body` in the last step.
+  void WakeTouching(std::uint32_t body);
+
+  // The stages of Step, in order, one file each (step_*.cc).
+  void UpdateBroadPhase(double dt);   // 1. broad phase: swept boxes, candidate pairs
+  void UpdateNarrowPhase(double dt);  // 2. narrow phase: manifolds per shape pair
+  void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
+  void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
+  void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
+  void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  double ContactDistance(const Body& a, const Body& b, double dt) const;
+  bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
+                     const Pose& world_from_shape_b, ShapePairContact* entry) const;
+  void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
+                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
+  void UpdateSleep(double dt);
+  bool UpdateSpeedingUp(double dt, Body* body) const;
+  void DisableNonFiniteBodies();
+  // `pairs` are the touching pairs, one per solver manifold.
+  void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt);
+  ContactReport MakeReport(const ShapePairContact& pair, int point,
+                           const std::array<Vec3, 2>& tangent, double dt) const;
+
+  WorldSettings settings_;
+  std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
+  std::vector<std::uint32_t> free_slots_;
+  std::size_t body_count_ = 0;
+  double time_ = 0.0;
+  std::uint64_t step_count_ = 0;
+  SweepAndSortBroadPhase broad_phase_;
+  std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
+  ContactCache contact_cache_;
+  bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3
+  // contacts_ begins with the reports of the sleeping pairs, made when
+  // their list last changed (its version is kept here).
+  std::uint64_t sleeping_reports_version_ = ~std::uint64_t{0};
+  std::size_t sleeping_report_count_ = 0;
+  ContactSolver solver_;
+  std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
+  std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
+  std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
+  std::vector<ContactReport> contacts_;
+  std::vector<ContactReport> collision_log_;
+  std::vector<BodyId> non_finite_bodies_;
+  StepProfile last_step_profile_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_WORLD_IMPL_H_

@@ -1,0 +1,91 @@
+#include "rigid_body_sim/physics/world_settings.h"
+
+#include <cmath>
+#include <string>
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// Each check returns an error naming the setting, its value and the range
+// it must lie in.
+Status FiniteAbove(const char* name, double value, double low, bool low_open, const char* range) {
+  const bool above = low_open ? value > low : value >= low;
+  if (std::isfinite(value) && above) return Status::Ok();
+  return Status::Error(std::string(name) + " " + FormatNumber(value) + " must be " + range);
+}
+
+Status AtLeast(const char* name, int value, int low) {
+  if (value >= low) return Status::Ok();
+  return Status::Error(std::string(name) + " " + std::to_string(value) +
+                       " must be >= " + std::to_string(low));
+}
+
+Status FirstError(std::initializer_list<Status> statuses) {
+  for (const Status& status : statuses) {
+    if (!status.ok()) return status;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ValidateSolverSettings(const SolverSettings& settings) {
+  const double correction = settings.position_correction;
+  return FirstError({
+      AtLeast("velocity_iterations", settings.velocity_iterations, 1),
+      AtLeast("position_iterations", settings.position_iterations, 0),
+      FiniteAbove("velocity_tolerance", settings.velocity_tolerance, 0.0, false, "finite and >= 0"),
+      FiniteAbove("collision_velocity_threshold", settings.collision_velocity_threshold, 0.0, false,
+                  "finite and >= 0"),
+      FiniteAbove("contact_tolerance", settings.contact_tolerance, 0.0, true, "finite and > 0"),
+      FiniteAbove("penetration_slop", settings.penetration_slop, 0.0, false, "finite and >= 0"),
+      correction > 0.0 && correction <= 1.0
+          ? Status::Ok()
+          : Status::Error("position_correction " + FormatNumber(correction) + " must be in (0, 1]"),
+      AtLeast("max_collision_rounds", settings.max_collision_rounds, 1),
+      AtLeast("collision_iterations", settings.collision_iterations, 1),
+      AtLeast("max_pivoting_points", settings.max_pivoting_points, 0),
+  });
+}
+
+Status ValidateWorldSettings(const WorldSettings& settings) {
+  if (!IsFinite(settings.gravity)) {
+    return Status::Error("gravity [" + FormatNumber(settings.gravity.x()) + ", " +
+                         FormatNumber(settings.gravity.y()) + ", " +
+                         FormatNumber(settings.gravity.z()) + "] m/s^2 must be finite");
+  }
+  const double fraction = settings.continuous_fraction;
+  const SleepSettings& sleep = settings.sleep;
+  if (Status status = FirstError({
+          FiniteAbove("time_step", settings.time_step, 0.0, true, "positive and finite (s)"),
+          FiniteAbove("contact_margin", settings.contact_margin, 0.0, false, "finite and >= 0 (m)"),
+          FiniteAbove("contact_reuse_distance", settings.contact_reuse_distance, 0.0, false,
+                      "finite and >= 0 (m)"),
+          fraction > 0.0 && fraction <= 1.0
+              ? Status::Ok()
+              : Status::Error("continuous_fraction " + FormatNumber(fraction) +
+                              " must be in (0, 1]"),
+          // Speeds may be infinite: every body may then sleep.
+          sleep.linear_velocity >= 0.0
+              ? Status::Ok()
+              : Status::Error("sleep.linear_velocity " + FormatNumber(sleep.linear_velocity) +
+                              " m/s must be >= 0"),
+          sleep.angular_velocity >= 0.0
+              ? Status::Ok()
+              : Status::Error("sleep.angular_velocity " + FormatNumber(sleep.angular_velocity) +
+                              " rad/s must be >= 0"),
+          FiniteAbove("sleep.time_to_sleep", sleep.time_to_sleep, 0.0, false,
+                      "finite and >= 0 (s)"),
+          FiniteAbove("sleep.speeding_up_time", sleep.speeding_up_time, 0.0, false,
+                      "finite and >= 0 (s)"),
+      });
+      !status.ok()) {
+    return status;
+  }
+  if (Status status = ValidateSolverSettings(settings.solver); !status.ok()) {
+    return Status::Error("solver." + status.message());
+  }
+  return Status::Ok();
+}
+
+}  // namespace rigid_body_sim::physics
