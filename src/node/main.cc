@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     ROS_FATAL("invalid parameters: %s", options.message().c_str());
     return 1;
   }
+  rigid_body_sim::node::WriteNodeOptions(*options, private_node);
   rigid_body_sim::node::SimNode node(*options, ros::NodeHandle(), private_node);
   ros::AsyncSpinner spinner(4);
   spinner.start();

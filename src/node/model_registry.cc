@@ -9,8 +9,8 @@
 namespace rigid_body_sim::node {
 
 using physics::BodyDef;
-using physics::Pose;
 using physics::FormatNumber;
+using physics::Pose;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;
@@ -27,7 +27,8 @@ Status ValidateModelName(const std::string& name) {
   for (std::size_t i = 0; i < name.size(); ++i) {
     const char c = name[i];
     if (i == 0 ? !IsNameStart(c) : !IsNameChar(c)) {
-      std::string shown = (c >= 0x20 && c < 0x7f) ? std::string(1, c) : "\\x" + FormatNumber(int(c));
+      std::string shown =
+          (c >= 0x20 && c < 0x7f) ? std::string(1, c) : "\\x" + FormatNumber(int(c));
       return Status::Error("model name '" + name + "' has a bad character '" + shown +
                            "' at position " + std::to_string(i) +
                            "; names match [A-Za-z_][A-Za-z0-9_]*");
@@ -47,7 +48,8 @@ Result<BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
     return Result<BodyDef>::Error("friction is infinite");
   }
   if (spec.restitution > 1.0) {
-    return Result<BodyDef>::Error("restitution " + FormatNumber(spec.restitution) + " is outside [0, 1]");
+    return Result<BodyDef>::Error("restitution " + FormatNumber(spec.restitution) +
+                                  " is outside [0, 1]");
   }
   BodyDef def;
   def.is_static = spec.is_static || model.is_static;

@@ -2,7 +2,8 @@
 
 #include <cmath>
 #include <set>
-#include <sstream>
+#include <type_traits>
+#include <variant>
 
 #include <xmlrpcpp/XmlRpcValue.h>
 
@@ -156,7 +157,8 @@ Status ValidateNodeOptions(const NodeOptions& options) {
                          " must be >= 0 (0: as fast as possible)");
   }
   if (!(options.publish_rate > 0.0) || !std::isfinite(options.publish_rate)) {
-    return Status::Error("~publish_rate " + FormatNumber(options.publish_rate) + " Hz must be positive");
+    return Status::Error("~publish_rate " + FormatNumber(options.publish_rate) +
+                         " Hz must be positive");
   }
   const auto check_friction = [](double value, const std::string& name) {
     return value >= 0.0 && std::isfinite(value)
@@ -188,7 +190,8 @@ Status ValidateNodeOptions(const NodeOptions& options) {
                          " must be >= 3");
   }
   if (!(options.status_period > 0.0) || !std::isfinite(options.status_period)) {
-    return Status::Error("~status_period " + FormatNumber(options.status_period) + " s must be positive");
+    return Status::Error("~status_period " + FormatNumber(options.status_period) +
+                         " s must be positive");
   }
   if (!(options.contact_force_scale > 0.0) || !std::isfinite(options.contact_force_scale)) {
     return Status::Error("~contact_force_scale " + FormatNumber(options.contact_force_scale) +
@@ -209,87 +212,124 @@ Status ValidateNodeOptions(const NodeOptions& options) {
   return Status::Ok();
 }
 
+namespace {
+
+// One scalar parameter of the private namespace and the option it sets.
+struct ScalarParam {
+  const char* name;
+  std::variant<double*, int*, bool*, std::string*> value;
+};
+
+// Every scalar parameter, named as under ~; the 3-vector ~gravity and the
+// list ~models are read on their own.
+std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
+  physics::WorldSettings& world = options->world;
+  physics::SolverSettings& solver = world.solver;
+  physics::SleepSettings& sleep = world.sleep;
+  return {
+      {"world_frame", &options->world_frame},
+      {"time_step", &world.time_step},
+      {"real_time_factor", &options->real_time_factor},
+      {"publish_rate", &options->publish_rate},
+      {"paused", &options->paused},
+      {"ground_plane", &options->ground_plane},
+      {"ground_friction", &options->ground_friction},
+      {"ground_restitution", &options->ground_restitution},
+      {"default_friction", &options->defaults.friction},
+      {"default_restitution", &options->defaults.restitution},
+      {"default_density", &options->default_density},
+      {"max_hull_vertices", &options->max_hull_vertices},
+      {"cylinder_segments", &options->cylinder_segments},
+      {"contact_margin", &world.contact_margin},
+      {"contact_reuse_distance", &world.contact_reuse_distance},
+      {"continuous_fraction", &world.continuous_fraction},
+      {"solver/velocity_iterations", &solver.velocity_iterations},
+      {"solver/velocity_tolerance", &solver.velocity_tolerance},
+      {"solver/position_iterations", &solver.position_iterations},
+      {"solver/collision_velocity_threshold", &solver.collision_velocity_threshold},
+      {"solver/contact_tolerance", &solver.contact_tolerance},
+      {"solver/penetration_slop", &solver.penetration_slop},
+      {"solver/position_correction", &solver.position_correction},
+      {"solver/max_collision_rounds", &solver.max_collision_rounds},
+      {"solver/collision_iterations", &solver.collision_iterations},
+      {"solver/max_pivoting_points", &solver.max_pivoting_points},
+      {"sleep/enabled", &sleep.enabled},
+      {"sleep/linear_velocity", &sleep.linear_velocity},
+      {"sleep/angular_velocity", &sleep.angular_velocity},
+      {"sleep/time_to_sleep", &sleep.time_to_sleep},
+      {"sleep/speeding_up_time", &sleep.speeding_up_time},
+      {"status_period", &options->status_period},
+      {"contact_force_scale", &options->contact_force_scale},
+  };
+}
+
+Status ReadScalar(const ros::NodeHandle& node, const ScalarParam& param) {
+  return std::visit(
+      [&](auto* out) {
+        using T = std::remove_pointer_t<decltype(out)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return ReadParam(node, param.name, ReadDouble, out);
+        } else if constexpr (std::is_same_v<T, int>) {
+          return ReadParam(node, param.name, ReadInt, out);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return ReadParam(node, param.name, ReadBool, out);
+        } else {
+          static_assert(std::is_same_v<T, std::string>);
+          return ReadParam(node, param.name, ReadString, out);
+        }
+      },
+      param.value);
+}
+
+Status ReadModels(const ros::NodeHandle& private_node, std::vector<ModelSpec>* models) {
+  XmlRpc::XmlRpcValue list;
+  if (!private_node.getParam("models", list)) return Status::Ok();
+  if (list.getType() != XmlRpc::XmlRpcValue::TypeArray) {
+    return Status::Error("parameter ~models must be a list");
+  }
+  for (int i = 0; i < list.size(); ++i) {
+    ModelSpec spec;
+    if (Status status = ReadModel(list[i], i, &spec); !status.ok()) return status;
+    models->push_back(std::move(spec));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node) {
   NodeOptions options;
+  for (const ScalarParam& param : ScalarParams(&options)) {
+    if (Status status = ReadScalar(private_node, param); !status.ok()) return status;
+  }
   std::vector<double> gravity;
-  const std::vector<Status> reads = {
-      ReadParam(private_node, "world_frame", ReadString, &options.world_frame),
-      ReadParam(private_node, "time_step", ReadDouble, &options.world.time_step),
-      ReadParam(private_node, "real_time_factor", ReadDouble, &options.real_time_factor),
-      ReadParam(private_node, "publish_rate", ReadDouble, &options.publish_rate),
-      ReadParam(private_node, "paused", ReadBool, &options.paused),
-      ReadParam(
+  if (Status status = ReadParam(
           private_node, "gravity",
           [](XmlRpc::XmlRpcValue& value, const std::string& what, std::vector<double>* out) {
             return ReadDoubles(value, what, 3, out);
           },
-          &gravity),
-      ReadParam(private_node, "ground_plane", ReadBool, &options.ground_plane),
-      ReadParam(private_node, "ground_friction", ReadDouble, &options.ground_friction),
-      ReadParam(private_node, "ground_restitution", ReadDouble, &options.ground_restitution),
-      ReadParam(private_node, "default_friction", ReadDouble, &options.defaults.friction),
-      ReadParam(private_node, "default_restitution", ReadDouble, &options.defaults.restitution),
-      ReadParam(private_node, "default_density", ReadDouble, &options.default_density),
-      ReadParam(private_node, "max_hull_vertices", ReadInt, &options.max_hull_vertices),
-      ReadParam(private_node, "cylinder_segments", ReadInt, &options.cylinder_segments),
-      ReadParam(private_node, "contact_margin", ReadDouble, &options.world.contact_margin),
-      ReadParam(private_node, "contact_reuse_distance", ReadDouble,
-                &options.world.contact_reuse_distance),
-      ReadParam(private_node, "continuous_fraction", ReadDouble,
-                &options.world.continuous_fraction),
-      ReadParam(private_node, "solver/velocity_iterations", ReadInt,
-                &options.world.solver.velocity_iterations),
-      ReadParam(private_node, "solver/velocity_tolerance", ReadDouble,
-                &options.world.solver.velocity_tolerance),
-      ReadParam(private_node, "solver/position_iterations", ReadInt,
-                &options.world.solver.position_iterations),
-      ReadParam(private_node, "solver/collision_velocity_threshold", ReadDouble,
-                &options.world.solver.collision_velocity_threshold),
-      ReadParam(private_node, "solver/contact_tolerance", ReadDouble,
-                &options.world.solver.contact_tolerance),
-      ReadParam(private_node, "solver/penetration_slop", ReadDouble,
-                &options.world.solver.penetration_slop),
-      ReadParam(private_node, "solver/position_correction", ReadDouble,
-                &options.world.solver.position_correction),
-      ReadParam(private_node, "solver/max_collision_rounds", ReadInt,
-                &options.world.solver.max_collision_rounds),
-      ReadParam(private_node, "solver/collision_iterations", ReadInt,
-                &options.world.solver.collision_iterations),
-      ReadParam(private_node, "sleep/enabled", ReadBool, &options.world.sleep.enabled),
-      ReadParam(private_node, "sleep/linear_velocity", ReadDouble,
-                &options.world.sleep.linear_velocity),
-      ReadParam(private_node, "sleep/angular_velocity", ReadDouble,
-                &options.world.sleep.angular_velocity),
-      ReadParam(private_node, "sleep/time_to_sleep", ReadDouble,
-                &options.world.sleep.time_to_sleep),
-      ReadParam(private_node, "sleep/speeding_up_time", ReadDouble,
-                &options.world.sleep.speeding_up_time),
-      ReadParam(private_node, "status_period", ReadDouble, &options.status_period),
-      ReadParam(private_node, "contact_force_scale", ReadDouble, &options.contact_force_scale),
-  };
-  for (const Status& status : reads) {
-    if (!status.ok()) return status;
+          &gravity);
+      !status.ok()) {
+    return status;
   }
+  if (!gravity.empty()) options.world.gravity = Vec3(gravity[0], gravity[1], gravity[2]);
   ros::NodeHandle root_node;
   if (Status status = ReadParam(root_node, "/use_sim_time", ReadBool, &options.use_sim_time);
       !status.ok()) {
     return status;
   }
-  if (!gravity.empty()) options.world.gravity = Vec3(gravity[0], gravity[1], gravity[2]);
-
-  XmlRpc::XmlRpcValue models;
-  if (private_node.getParam("models", models)) {
-    if (models.getType() != XmlRpc::XmlRpcValue::TypeArray) {
-      return Status::Error("parameter ~models must be a list");
-    }
-    for (int i = 0; i < models.size(); ++i) {
-      ModelSpec spec;
-      if (Status status = ReadModel(models[i], i, &spec); !status.ok()) return status;
-      options.models.push_back(std::move(spec));
-    }
-  }
+  if (Status status = ReadModels(private_node, &options.models); !status.ok()) return status;
   if (Status status = ValidateNodeOptions(options); !status.ok()) return status;
   return options;
+}
+
+void WriteNodeOptions(const NodeOptions& options, const ros::NodeHandle& private_node) {
+  NodeOptions copy = options;
+  for (const ScalarParam& param : ScalarParams(&copy)) {
+    std::visit([&](auto* value) { private_node.setParam(param.name, *value); }, param.value);
+  }
+  const Vec3& gravity = options.world.gravity;
+  private_node.setParam("gravity", std::vector<double>{gravity.x(), gravity.y(), gravity.z()});
 }
 
 }  // namespace rigid_body_sim::node

@@ -2,7 +2,8 @@
 
 namespace rigid_body_sim::physics {
 
-// Derived quantities of Baraff's state (seed 002, "Rigid Body Dynamics"):
+// Derived quantities of Baraff's state (Baraff 1997, "Rigid Body
+// Simulation I", section 2.11, eqs. (2-40)-(2-42); R from q by section 4):
 // v = P / M, R = R(q), I_world^-1 = R I_body^-1 R^T, omega = I_world^-1 L.
 void Body::UpdateDerived() {
   if (is_static) {

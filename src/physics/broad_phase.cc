@@ -28,28 +28,28 @@ Status ValidateAabb(const Aabb& aabb_world) {
 
 }  // namespace
 
-Status SweepAndSortBroadPhase::CheckId(int id) const {
+Status SortAndSweepBroadPhase::CheckId(int id) const {
   if (!Contains(id)) {
     return Status::Error("broad phase: no proxy with id " + std::to_string(id));
   }
   return Status::Ok();
 }
 
-bool SweepAndSortBroadPhase::Contains(int id) const {
+bool SortAndSweepBroadPhase::Contains(int id) const {
   return id >= 0 && static_cast<std::size_t>(id) < proxies_.size() && proxies_[id].in_use;
 }
 
-const Aabb& SweepAndSortBroadPhase::GetAabb(int id) const {
+const Aabb& SortAndSweepBroadPhase::GetAabb(int id) const {
   assert(Contains(id));
   return proxies_[id].aabb_world;
 }
 
-ProxyKind SweepAndSortBroadPhase::GetKind(int id) const {
+ProxyKind SortAndSweepBroadPhase::GetKind(int id) const {
   assert(Contains(id));
   return proxies_[id].kind;
 }
 
-Result<int> SweepAndSortBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind kind) {
+Result<int> SortAndSweepBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind kind) {
   // Ids chosen by the caller may have taken entries of the free list since
   // they were pushed; drop those lazily.
   while (!free_ids_.empty() && proxies_[free_ids_.back()].in_use) {
@@ -67,7 +67,7 @@ Result<int> SweepAndSortBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind k
   return static_cast<int>(id);
 }
 
-Status SweepAndSortBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, ProxyKind kind) {
+Status SortAndSweepBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, ProxyKind kind) {
   if (id < 0 || id > kMaxProxyId) {
     return Status::Error("broad phase: proxy id " + std::to_string(id) + " is outside [0, " +
                          std::to_string(kMaxProxyId) + "]");
@@ -107,7 +107,7 @@ Status SweepAndSortBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, Pr
   return Status::Ok();
 }
 
-Status SweepAndSortBroadPhase::RemoveProxy(int id) {
+Status SortAndSweepBroadPhase::RemoveProxy(int id) {
   if (Status status = CheckId(id); !status.ok()) {
     return status;
   }
@@ -134,7 +134,7 @@ Status SweepAndSortBroadPhase::RemoveProxy(int id) {
   return Status::Ok();
 }
 
-Status SweepAndSortBroadPhase::SetAabb(int id, const Aabb& aabb_world) {
+Status SortAndSweepBroadPhase::SetAabb(int id, const Aabb& aabb_world) {
   if (Status status = CheckId(id); !status.ok()) {
     return status;
   }
@@ -149,12 +149,12 @@ Status SweepAndSortBroadPhase::SetAabb(int id, const Aabb& aabb_world) {
   return Status::Ok();
 }
 
-double SweepAndSortBroadPhase::CurrentValue(const Endpoint& endpoint, int axis) const {
+double SortAndSweepBroadPhase::CurrentValue(const Endpoint& endpoint, int axis) const {
   const Aabb& aabb_world = proxies_[endpoint.proxy].aabb_world;
   return endpoint.is_end != 0 ? aabb_world.max[axis] : aabb_world.min[axis];
 }
 
-Status SweepAndSortBroadPhase::SetKind(int id, ProxyKind kind) {
+Status SortAndSweepBroadPhase::SetKind(int id, ProxyKind kind) {
   if (Status status = CheckId(id); !status.ok()) {
     return status;
   }
@@ -186,7 +186,7 @@ Status SweepAndSortBroadPhase::SetKind(int id, ProxyKind kind) {
 // insertion sort turn it into the pair set of the new values. Overlap in list
 // order on an axis: begin_a before end_b and begin_b before end_a. Scans the x
 // list up to the proxy's end: O(n) integer comparisons.
-std::vector<std::uint32_t> SweepAndSortBroadPhase::OverlappingInListOrder(std::uint32_t id) const {
+std::vector<std::uint32_t> SortAndSweepBroadPhase::OverlappingInListOrder(std::uint32_t id) const {
   const Proxy& mine = proxies_[id];
   const std::vector<Endpoint>& list_x = endpoints_[0];
   std::vector<std::uint32_t> result;
@@ -206,7 +206,7 @@ std::vector<std::uint32_t> SweepAndSortBroadPhase::OverlappingInListOrder(std::u
   return result;
 }
 
-void SweepAndSortBroadPhase::RemoveDeadEndpoints() {
+void SortAndSweepBroadPhase::RemoveDeadEndpoints() {
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<Endpoint>& list = endpoints_[axis];
     std::uint32_t write = 0;
@@ -223,12 +223,12 @@ void SweepAndSortBroadPhase::RemoveDeadEndpoints() {
   dead_endpoint_count_ = 0;
 }
 
-// Sort and sweep from scratch (Baraff, seed 000): sort the endpoints of each
-// axis, then walk one axis keeping the set of open intervals; each begin
-// meets exactly the proxies whose intervals are open on that axis, and those
+// Sort and sweep from scratch (Baraff 1997, "Rigid Body Simulation II",
+// section 7.2.1): sort the endpoints of each axis, then walk one axis keeping the set of open
+// intervals; each begin meets exactly the proxies whose intervals are open on that axis, and those
 // are tested on all three axes. The walk uses the axis on which the box
 // centres spread most, where the fewest intervals are open at once.
-void SweepAndSortBroadPhase::RebuildFromScratch() {
+void SortAndSweepBroadPhase::RebuildFromScratch() {
   pairs_.clear();
   sorted_pairs_stale_ = true;
   for (int axis = 0; axis < 3; ++axis) {
@@ -280,9 +280,10 @@ void SweepAndSortBroadPhase::RebuildFromScratch() {
   }
 }
 
-// Insertion sort of one axis with pair updates on swaps (Baraff, seed 002,
-// "sort and sweep with coherence"). Only a swap of a begin with an end changes
-// whether two intervals overlap on this axis:
+// Insertion sort of one axis with pair updates on swaps (Baraff 1997,
+// "Rigid Body Simulation II", sections 7.2.1-7.2.2: insertion sort of the
+// nearly sorted list, overlap changes found at the swaps). Only a swap of a begin with an end
+// changes whether two intervals overlap on this axis:
 //   begin_a moves before end_b: a and b may now overlap; they are a pair if
 //     their new boxes overlap on all three axes;
 //   end_a moves before begin_b: a and b are now disjoint on this axis.
@@ -302,7 +303,7 @@ void SweepAndSortBroadPhase::RebuildFromScratch() {
 //
 // Indices in the proxies are fixed after the pass, once per position inside
 // the stretches that moved, instead of once per swap.
-void SweepAndSortBroadPhase::InsertionSortAxis(int axis) {
+void SortAndSweepBroadPhase::InsertionSortAxis(int axis) {
   std::vector<Endpoint>& list = endpoints_[axis];
   const int first_slot = 2 * axis;
   const int other_axis_1 = (axis + 1) % 3;
@@ -361,7 +362,7 @@ void SweepAndSortBroadPhase::InsertionSortAxis(int axis) {
   flush_stale();
 }
 
-void SweepAndSortBroadPhase::Update() {
+void SortAndSweepBroadPhase::Update() {
   last_update_swaps_ = 0;
   if (dead_endpoint_count_ > 0) {
     RemoveDeadEndpoints();
@@ -384,15 +385,15 @@ void SweepAndSortBroadPhase::Update() {
   built_ = true;
 }
 
-void SweepAndSortBroadPhase::AddPair(std::uint64_t key) {
+void SortAndSweepBroadPhase::AddPair(std::uint64_t key) {
   if (pairs_.insert(key).second) sorted_pairs_stale_ = true;
 }
 
-void SweepAndSortBroadPhase::ErasePair(std::uint64_t key) {
+void SortAndSweepBroadPhase::ErasePair(std::uint64_t key) {
   if (pairs_.erase(key) > 0) sorted_pairs_stale_ = true;
 }
 
-const std::vector<ProxyPair>& SweepAndSortBroadPhase::Pairs() const {
+const std::vector<ProxyPair>& SortAndSweepBroadPhase::Pairs() const {
   if (!sorted_pairs_stale_) return sorted_pairs_;
   std::vector<std::uint64_t> keys(pairs_.begin(), pairs_.end());
   std::sort(keys.begin(), keys.end());
@@ -406,7 +407,7 @@ const std::vector<ProxyPair>& SweepAndSortBroadPhase::Pairs() const {
   return sorted_pairs_;
 }
 
-bool SweepAndSortBroadPhase::HasPair(int a, int b) const {
+bool SortAndSweepBroadPhase::HasPair(int a, int b) const {
   if (a < 0 || b < 0 || a == b) {
     return false;
   }

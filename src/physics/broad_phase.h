@@ -1,7 +1,7 @@
 // Broad phase: which pairs of bodies have overlapping world AABBs.
 //
-// Sort and sweep with coherence (Baraff, seed 000 slides 5-10; seed 002
-// "Sort and sweep algorithm: from scratch / with coherence"). Each proxy's
+// Sort and sweep with coherence (Baraff 1997, "Rigid Body Simulation II",
+// section 7.2: sort and sweep, insertion sort for coherence). Each proxy's
 // box contributes a begin and an end endpoint to a sorted list per axis. A pair
 // is reported only when its intervals overlap on all three axes (the
 // intersection of the per-axis overlaps, not their union).
@@ -50,7 +50,7 @@ struct ProxyState {
 };
 
 // Reference broad phase: tests every pair directly, O(n^2). Same rules as
-// SweepAndSortBroadPhase (closed intervals, overlap on all three axes, at
+// SortAndSweepBroadPhase (closed intervals, overlap on all three axes, at
 // least one dynamic proxy). Returns the pairs sorted by (first, second).
 // Ids must be distinct and boxes valid (asserted).
 std::vector<ProxyPair> BruteForcePairs(const std::vector<ProxyState>& proxies);
@@ -71,7 +71,7 @@ std::vector<ProxyPair> BruteForcePairs(const std::vector<ProxyState>& proxies);
 //
 // Pairs of a removed proxy are dropped at once; every other change shows in
 // the pairs after the next Update().
-class SweepAndSortBroadPhase {
+class SortAndSweepBroadPhase {
  public:
   // Ids are array indices, so they are bounded to keep memory proportional
   // to the number of proxies.

@@ -5,7 +5,7 @@
 
 namespace rigid_body_sim::physics {
 
-// Reference for SweepAndSortBroadPhase: every pair of boxes is tested
+// Reference for SortAndSweepBroadPhase: every pair of boxes is tested
 // directly on all three axes, O(n^2), with the same reporting rule.
 std::vector<ProxyPair> BruteForcePairs(const std::vector<ProxyState>& proxies) {
   std::vector<ProxyPair> pairs;

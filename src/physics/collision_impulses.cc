@@ -18,8 +18,8 @@ namespace {
 constexpr double kCollisionConvergence = 1e-10;
 
 // 1 / (1/Ma + 1/Mb + (ra x d).Ia^-1 (ra x d) + (rb x d).Ib^-1 (rb x d)):
-// the mass the contact "feels" along d (Baraff, seed 000 slide 34,
-// denominator of j).
+// the mass the contact "feels" along d (Baraff 1997, "Rigid Body
+// Simulation II", section 8, the denominator of eq. (8-18)).
 double EffectiveMass(const SolverBody& a, const SolverBody& b, const Vec3& r_a, const Vec3& r_b,
                      const Vec3& direction) {
   const Vec3 ra_x_d = r_a.cross(direction);

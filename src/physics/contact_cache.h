@@ -1,7 +1,8 @@
 // Stage 3 of a step: contacts carried from one step to the next.
 //
 // Per pair of shapes the broad phase reports, the cache keeps the separating
-// witness (Baraff's cached defining face or edge, seed 000 slide 13) and the
+// witness (Baraff's cached defining face or edge: Baraff 1997,
+// "Rigid Body Simulation II", section 7.1) and the
 // impulses of last step's contact points, so the narrow phase tests the
 // witness first and the solver starts from last step's impulses.
 #ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_CACHE_H_

@@ -65,13 +65,15 @@ Vec3 ContactSolver::RelativeVelocity(const SolverManifold& manifold,
          b.angular_velocity.cross(point.r_b);
 }
 
-// v_r = n . (pa' - pb'), pa' = va + wa x ra (Baraff, seed 000 slide 19).
+// v_r = n . (pa' - pb'), pa' = va + wa x ra (Baraff 1997, "Rigid Body
+// Simulation II", section 8, eqs. (8-1)-(8-3)).
 double ContactSolver::NormalVelocity(const SolverManifold& manifold,
                                      const SolverPoint& point) const {
   return manifold.normal_world.dot(RelativeVelocity(manifold, point));
 }
 
-// P_a += J, L_a += r_a x J; the opposite on B (Baraff, seed 000 slide 34).
+// P_a += J, L_a += r_a x J; the opposite on B (Baraff 1997,
+// "Rigid Body Simulation II", section 8, eqs. (8-5)-(8-7) and (8-12)).
 void ContactSolver::ApplyImpulse(const SolverManifold& manifold, const SolverPoint& point,
                                  const Vec3& impulse_world) {
   SolverBody& a = bodies_[manifold.body_a];

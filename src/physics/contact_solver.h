@@ -1,10 +1,11 @@
 // Stage 4 of a step: contact dynamics.
 //
-// Baraff's order (seed 002, "Outline"): colliding contacts are resolved first
-// by impulses, on the velocities the step starts with; then the forces act
-// and resting contacts get the forces that keep them from penetrating. Both
-// are solved for all the contacts at once, as linear complementarity
-// problems at the velocity level (impulses over the step).
+// Baraff's order (Baraff 2001, "Collision and Contact" course slides,
+// "Outline"; Baraff 1997, "Rigid Body Simulation II", section 8, then 9): colliding contacts are
+// resolved first by impulses, on the velocities the step starts with; then the forces act and
+// resting contacts get the forces that keep them from penetrating. Both are solved for all the
+// contacts at once, as linear complementarity problems at the velocity level (impulses over the
+// step).
 #ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_SOLVER_H_
 #define RIGID_BODY_SIM_PHYSICS_CONTACT_SOLVER_H_
 
@@ -137,7 +138,8 @@ class ContactSolver {
   // (v_r+ >= 0, j_c v_r+ = 0, with Coulomb friction), then adds the
   // restitution impulses e j_c (Poisson's hypothesis). For one point this is
   // Baraff's impulse j = -(1+e) v_r- / (1/Ma + 1/Mb + n.(Ia^-1(ra x n)) x ra
-  // + n.(Ib^-1(rb x n)) x rb) (seed 000 slide 34); for several it never adds
+  // + n.(Ib^-1(rb x n)) x rb) (Baraff 1997, "Rigid Body Simulation II", eq. (8-18));
+  // for several it never adds
   // energy: dE = -(1 - e^2)/2 j_c.A j_c. Points that a round made colliding
   // (a row of balls) are resolved in the next round. Rounds stop once no
   // colliding point has e > 0: a perfectly inelastic collision needs only

@@ -23,7 +23,7 @@ namespace rigid_body_sim::physics {
 namespace {
 
 // dq/dt = 1/2 (0, omega) q with omega = R(q) I_principal^-1 R(q)^T L
-// (Baraff, seed 002 "Rigid Body Dynamics": q' = 1/2 omega q).
+// (Baraff 1997, "Rigid Body Simulation I", section 4, eq. (4-2)).
 Eigen::Vector4d QuaternionRate(const Eigen::Vector4d& wxyz, const Vec3& inverse_principal_moments,
                                const Vec3& angular_momentum_world) {
   const Quat q(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);

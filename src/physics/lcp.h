@@ -1,7 +1,8 @@
 // Linear complementarity problems of contact: find f with
 //   f >= 0,  w = A f + b >= 0,  f . w = 0
-// (Baraff, seed 001/002 "Resting Contact": repulsive, non-penetration and
-// workless conditions, solved for all contacts at once).
+// (Baraff 1997, "Rigid Body Simulation II", section 9, eqs. (9-5)-(9-7): the
+// non-penetration, repulsive and workless conditions, solved for all
+// contacts at once; here in their velocity-level form over a step).
 #ifndef RIGID_BODY_SIM_PHYSICS_LCP_H_
 #define RIGID_BODY_SIM_PHYSICS_LCP_H_
 

@@ -145,7 +145,8 @@ void ContactSolver::FindIslands() {
 // rows, has its normal impulses solved again by pivoting (lcp.h), all at
 // once and exactly, with its friction impulses held: f >= 0,
 // w = A f + b >= 0, f . w = 0, where w_i = n_i . v_r,i - target_i and
-// A_ik = J_i M^-1 J_k^T (Baraff, seed 002, "Resting Contact"), so
+// A_ik = J_i M^-1 J_k^T (Baraff 1997, "Rigid Body Simulation II",
+// section 9, eq. (9-8) and appendix D), so
 // b = w(now) - A f(now). Gauss-Seidel gains about m/M of the way per sweep
 // where a light body carries a heavy one; pivoting does not depend on the
 // masses. Friction that the new normal impulses leave outside its cone is

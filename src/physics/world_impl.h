@@ -62,6 +62,12 @@ class WorldImpl {
   void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
   void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
   void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
+  // Stage 5's parts (step_integrator.cc).
+  void DriftBodies(double dt);
+  void BoundBodyMotion(double dt);
+  void BackUpToImpacts(double dt);
+  double PairImpactTime(double dt, ShapePairContact* pair);
+  int PathSamples(std::uint32_t body_a, std::uint32_t body_b) const;
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
   double ContactDistance(const Body& a, const Body& b, double dt) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
@@ -82,7 +88,7 @@ class WorldImpl {
   std::size_t body_count_ = 0;
   double time_ = 0.0;
   std::uint64_t step_count_ = 0;
-  SweepAndSortBroadPhase broad_phase_;
+  SortAndSweepBroadPhase broad_phase_;
   std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
   ContactCache contact_cache_;
   bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3

@@ -73,8 +73,8 @@ TEST(AabbTest, ValidityRequiresFiniteCornersAndOrderedBounds) {
   EXPECT_FALSE(Box(0, 0, 0, 1, 1, std::numeric_limits<double>::infinity()).IsValid());
 }
 
-TEST(SweepAndSortBroadPhaseTest, PairNeedsOverlapOnAllThreeAxes) {
-  SweepAndSortBroadPhase broad_phase;
+TEST(SortAndSweepBroadPhaseTest, PairNeedsOverlapOnAllThreeAxes) {
+  SortAndSweepBroadPhase broad_phase;
   const int a = broad_phase.AddProxy(Box(0, 0, 0, 1, 1, 1), ProxyKind::kDynamic).value();
   const int x_only = broad_phase.AddProxy(Box(0.5, 2, 2, 1.5, 3, 3), ProxyKind::kDynamic).value();
   const int x_and_y =
@@ -106,8 +106,8 @@ TEST(SweepAndSortBroadPhaseTest, PairNeedsOverlapOnAllThreeAxes) {
   EXPECT_EQ(broad_phase.Pairs(), expected);
 }
 
-TEST(SweepAndSortBroadPhaseTest, StaticAndSleepingPairsFollowTheRules) {
-  SweepAndSortBroadPhase broad_phase;
+TEST(SortAndSweepBroadPhaseTest, StaticAndSleepingPairsFollowTheRules) {
+  SortAndSweepBroadPhase broad_phase;
   // All four boxes overlap each other.
   const int static_a = broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kStatic).value();
   const int static_b =
@@ -147,8 +147,8 @@ TEST(SweepAndSortBroadPhaseTest, StaticAndSleepingPairsFollowTheRules) {
   EXPECT_EQ(broad_phase.PairCount(), 0u);
 }
 
-TEST(SweepAndSortBroadPhaseTest, IdsChosenOrHandedOut) {
-  SweepAndSortBroadPhase broad_phase;
+TEST(SortAndSweepBroadPhaseTest, IdsChosenOrHandedOut) {
+  SortAndSweepBroadPhase broad_phase;
   ASSERT_TRUE(broad_phase.AddProxyWithId(3, UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic).ok());
   EXPECT_EQ(broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic).value(), 0);
   EXPECT_EQ(broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic).value(), 1);
@@ -164,8 +164,8 @@ TEST(SweepAndSortBroadPhaseTest, IdsChosenOrHandedOut) {
   EXPECT_EQ(broad_phase.ProxyCount(), 5u);
 }
 
-TEST(SweepAndSortBroadPhaseTest, RefusesBadInputAndKeepsState) {
-  SweepAndSortBroadPhase broad_phase;
+TEST(SortAndSweepBroadPhaseTest, RefusesBadInputAndKeepsState) {
+  SortAndSweepBroadPhase broad_phase;
   const int id = broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic).value();
   const double nan = std::numeric_limits<double>::quiet_NaN();
 
@@ -182,7 +182,7 @@ TEST(SweepAndSortBroadPhaseTest, RefusesBadInputAndKeepsState) {
   EXPECT_NE(duplicate.message().find("already in use"), std::string::npos);
   EXPECT_FALSE(broad_phase.AddProxyWithId(-1, UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic).ok());
   EXPECT_FALSE(broad_phase
-                   .AddProxyWithId(SweepAndSortBroadPhase::kMaxProxyId + 1,
+                   .AddProxyWithId(SortAndSweepBroadPhase::kMaxProxyId + 1,
                                    UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic)
                    .ok());
 
@@ -226,7 +226,7 @@ class RandomBoxWorld {
 
   explicit RandomBoxWorld(std::uint64_t seed) : rng_(seed) {}
 
-  void AddRandomBox(SweepAndSortBroadPhase& broad_phase, bool choose_id) {
+  void AddRandomBox(SortAndSweepBroadPhase& broad_phase, bool choose_id) {
     Box box;
     box.on_grid = Uniform(0, 1) < 0.5;
     for (int axis = 0; axis < 3; ++axis) {
@@ -259,13 +259,13 @@ class RandomBoxWorld {
     boxes_[id] = box;
   }
 
-  void RemoveRandomBox(SweepAndSortBroadPhase& broad_phase) {
+  void RemoveRandomBox(SortAndSweepBroadPhase& broad_phase) {
     const int id = RandomId();
     ASSERT_TRUE(broad_phase.RemoveProxy(id).ok());
     boxes_.erase(id);
   }
 
-  void ToggleRandomKind(SweepAndSortBroadPhase& broad_phase) {
+  void ToggleRandomKind(SortAndSweepBroadPhase& broad_phase) {
     const int id = RandomId();
     Box& box = boxes_[id];
     const double draw = Uniform(0, 1);
@@ -279,7 +279,7 @@ class RandomBoxWorld {
     ASSERT_TRUE(broad_phase.SetKind(id, box.kind).ok());
   }
 
-  void Teleport(SweepAndSortBroadPhase& broad_phase) {
+  void Teleport(SortAndSweepBroadPhase& broad_phase) {
     const int id = RandomId();
     Box& box = boxes_[id];
     for (int axis = 0; axis < 3; ++axis) {
@@ -290,7 +290,7 @@ class RandomBoxWorld {
   }
 
   // Moves the dynamic boxes by velocity * dt, reflecting at the region walls.
-  void Move(SweepAndSortBroadPhase& broad_phase) {
+  void Move(SortAndSweepBroadPhase& broad_phase) {
     for (auto& [id, box] : boxes_) {
       if (box.kind != ProxyKind::kDynamic) {
         continue;
@@ -363,10 +363,10 @@ class RandomBoxWorld {
   int next_chosen_id_ = 3000;
 };
 
-TEST(SweepAndSortBroadPhaseTest, MatchesBruteForceOver500StepsOf2000Boxes) {
+TEST(SortAndSweepBroadPhaseTest, MatchesBruteForceOver500StepsOf2000Boxes) {
   constexpr int kBoxes = 2000;
   constexpr int kSteps = 500;
-  SweepAndSortBroadPhase broad_phase;
+  SortAndSweepBroadPhase broad_phase;
   RandomBoxWorld world(20240611);
   for (int i = 0; i < kBoxes; ++i) {
     world.AddRandomBox(broad_phase, /*choose_id=*/i % 7 == 0);

@@ -1,4 +1,5 @@
-// Colliding contact: impulses with restitution (Baraff, seed 000 slides 28-34).
+// Colliding contact: impulses with restitution (Baraff 1997,
+// "Rigid Body Simulation II", section 8, eqs. (8-7)-(8-18)).
 #include <cmath>
 #include <vector>
 
@@ -91,7 +92,8 @@ TEST(CollisionTest, InelasticBoxDroppedFlatComesToRestWithoutRebound) {
 }
 
 // A box strikes the ground on one corner with given v and omega. The result
-// must equal Baraff's impulse computed by hand (seed 000 slide 34):
+// must equal Baraff's impulse computed by hand (Baraff 1997,
+// "Rigid Body Simulation II", eq. (8-18)):
 // j = -(1+e) v_r / (1/M + n.(I^-1 (r x n)) x r), P += j n, L += r x j n.
 // An inelastic box landing flat at 5 m/s on a static box yawed 0.1 rad
 // against it: the impact stops it at every corner at once, so it neither
@@ -138,7 +140,7 @@ TEST(CollisionTest, InelasticFaceLandingStopsAtEveryCornerAtOnce) {
   EXPECT_GT(lowest, 1.0 - world.settings().solver.penetration_slop - 1e-6);
 }
 
-TEST(CollisionTest, CornerImpactMatchesSeedFormula) {
+TEST(CollisionTest, CornerImpactMatchesBaraffImpulse) {
   WorldSettings settings;
   settings.gravity = Vec3::Zero();
   settings.sleep.enabled = false;

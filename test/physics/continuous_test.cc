@@ -1,5 +1,5 @@
 // No tunnelling: fast bodies are backed up to their time of impact
-// (Baraff, seed 000 slide 4) instead of passing through thin walls.
+// (Baraff 1997, "Rigid Body Simulation II", section 6) instead of passing through thin walls.
 #include <algorithm>
 #include <array>
 #include <limits>

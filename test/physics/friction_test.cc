@@ -21,7 +21,8 @@ constexpr double kMu = 0.5;
 constexpr double kDegree = M_PI / 180.0;
 
 // A box at rest on the ground: the resting-contact forces carry its weight,
-// sum f_i = m g (Baraff, seed 002 "Resting Contact"), and it stays put.
+// sum f_i = m g (Baraff 1997, "Rigid Body
+// Simulation II", section 9, eqs. (9-5)-(9-7)), and it stays put.
 TEST(RestingContactTest, BoxOnGroundCarriesItsWeightAndStaysPut) {
   World world;
   const BodyId ground = AddGround(&world, MakeMaterial(kMu, 0.0));

@@ -18,8 +18,9 @@ struct RandomContactProblem {
 };
 
 // A = J M^-1 J^T for `contacts` random contacts between random pairs of
-// `bodies` random bodies (Baraff, seed 002: the a_ij of the resting-contact
-// conditions are exactly the entries of this matrix), b random with both signs.
+// `bodies` random bodies (the a_ij of the resting-contact conditions,
+// Baraff 1997, "Rigid Body Simulation II", eq. (9-8) and appendix D, are
+// exactly the entries of this matrix), b random with both signs.
 RandomContactProblem MakeProblem(std::mt19937* rng, int bodies, int contacts) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> mass_dist(0.5, 5.0);

@@ -15,8 +15,8 @@ namespace rigid_body_sim::physics {
 namespace {
 
 using testing::BoxMesh;
-using testing::CylinderMesh;
 using testing::Contains;
+using testing::CylinderMesh;
 using testing::Icosphere;
 using testing::PrismMassProperties;
 using testing::RelativeDifference;

@@ -16,10 +16,10 @@
 
 #include <gtest/gtest.h>
 
-#include "rigid_body_sim/physics/convex_polyhedron.h"
 #include "physics/gjk.h"
 #include "physics/narrow_phase.h"
 #include "physics/polyhedron_collision.h"
+#include "rigid_body_sim/physics/convex_polyhedron.h"
 
 namespace rigid_body_sim::physics {
 namespace {

@@ -24,10 +24,11 @@ struct NodeOptions {
   // 1e-6), position_iterations (6),
   // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-5),
   // penetration_slop (m, 1e-4), position_correction (1/step, 0.2),
-  // max_collision_rounds (32), collision_iterations (30)} and
+  // max_collision_rounds (32), collision_iterations (30),
+  // max_pivoting_points (count, 32)} and
   // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
   // (rad/s, 0.1), time_to_sleep (s, 0.5), speeding_up_time (s, 0.2)}; see
-  // physics/world.h.
+  // physics/world_settings.h.
   physics::WorldSettings world;
   double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
   double publish_rate = 50.0;       // ~publish_rate: Hz of /tf, ~states, ~contacts, > 0
@@ -59,6 +60,11 @@ physics::Status ValidateNodeOptions(const NodeOptions& options);
 // validates the result. Fails, naming the parameter, on a wrong type or an
 // invalid value.
 physics::Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node);
+
+// Writes every parameter's effective value (the default where it was unset)
+// back under the private namespace, so that `rosparam get` shows what the
+// node runs with. ~models is left as given.
+void WriteNodeOptions(const NodeOptions& options, const ros::NodeHandle& private_node);
 
 // Fixed-axis roll about x, then pitch about y, then yaw about z (URDF rpy,
 // REP 103): R = Rz(yaw) Ry(pitch) Rx(roll).

@@ -26,9 +26,10 @@ struct SolverSettings {
   // m/s; epsilon of the classification: colliding when v_r < -epsilon,
   // resting when |v_r| <= epsilon.
   double collision_velocity_threshold = 0.01;
-  // m; points closer than this are touching (the seed's numerical
-  // tolerance): only they collide or rest. Closer points are reached by the
-  // time-of-impact search, so the approach speed, and the bounce, is exact.
+  // m; points closer than this are touching (the collision
+  // tolerance epsilon of Baraff 1997, "Rigid Body Simulation II", section 6): only they collide or
+  // rest. Closer points are reached by the time-of-impact search, so the approach speed, and the
+  // bounce, is exact.
   double contact_tolerance = 1e-5;
   // m; penetration left alone, so resting contacts persist from step to step.
   double penetration_slop = 1e-4;

@@ -1,0 +1,121 @@
+// The node's step loop: steps at the real-time factor, or flat out, and
+// hands what is due to Publish.
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+
+#include "rigid_body_sim/node/sim_node.h"
+
+namespace rigid_body_sim::node {
+
+using physics::BodyId;
+using physics::FormatNumber;
+using physics::Pose;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+namespace {
+
+// A sim loop that falls this far behind its real-time schedule stops trying
+// to catch up and restarts its schedule, so it never steps in bursts.
+constexpr double kMaxLagSeconds = 0.1;
+// /clock is published at most this often (s of real time) while stepping.
+constexpr double kClockPeriodSeconds = 0.001;
+
+}  // namespace
+
+void SimNode::StepLocked() {
+  for (ActiveWrench& wrench : wrenches_) {
+    Status status = world_.ApplyForceAtPoint(wrench.body, wrench.force_world, wrench.point_world);
+    assert(status.ok());
+    status = world_.ApplyTorque(wrench.body, wrench.torque_world);
+    assert(status.ok());
+    --wrench.remaining_steps;
+  }
+  wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(),
+                                 [](const ActiveWrench& w) { return w.remaining_steps <= 0; }),
+                  wrenches_.end());
+  world_.Step();
+  ++steps_;
+}
+
+void SimNode::ReanchorLocked() {
+  anchor_wall_ = Clock::now();
+  anchor_sim_ = world_.time();
+}
+
+void SimNode::StepLoop() {
+  const auto publish_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / options_.publish_rate));
+  const auto clock_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(kClockPeriodSeconds));
+  const auto status_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(options_.status_period));
+  Clock::time_point next_publish = Clock::now();
+  Clock::time_point next_clock = Clock::now();
+  Clock::time_point next_status = Clock::now() + status_period;
+  for (;;) {
+    Outbox outbox;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (shutdown_) return;
+      if (paused_) {
+        wake_.wait_until(lock, next_publish, [this] { return shutdown_ || !paused_; });
+        if (shutdown_) return;
+      } else if (real_time_factor_ > 0.0) {
+        // Real-time pacing: the next step is due when the wall clock has
+        // caught up with sim time / real_time_factor.
+        const auto due = anchor_wall_ +
+                         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                             (world_.time() - anchor_sim_) / real_time_factor_));
+        if (Clock::now() < due) {
+          const auto wake_at = std::min(due, next_publish);
+          const auto anchor = anchor_wall_;
+          wake_.wait_until(lock, wake_at,
+                           [&] { return shutdown_ || paused_ || anchor_wall_ != anchor; });
+          if (shutdown_) return;
+        } else if (Clock::now() - due > std::chrono::duration<double>(kMaxLagSeconds)) {
+          ReanchorLocked();
+        }
+        if (!paused_ && Clock::now() >= due) StepLocked();
+      } else {
+        StepLocked();
+      }
+      const Clock::time_point now = Clock::now();
+      if (now >= next_publish) {
+        FillPeriodicLocked(&outbox);
+        next_publish = std::max(next_publish + publish_period, now);
+      } else if (options_.use_sim_time && now >= next_clock && world_.time() > 0.0) {
+        outbox.clock = world_.time();
+      }
+      if (outbox.clock) next_clock = now + clock_period;
+      if (now >= next_status) {
+        LogStatusLocked(now);
+        next_status = now + status_period;
+      }
+    }
+    Publish(std::move(outbox));
+    // Service callers waiting for the mutex go first, so a flat-out loop
+    // cannot starve them.
+    while (waiting_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
+  }
+}
+
+void SimNode::LogStatusLocked(Clock::time_point now) {
+  const double wall = std::chrono::duration<double>(now - status_wall_).count();
+  const double achieved = wall > 0.0 ? (world_.time() - status_sim_) / wall : 0.0;
+  std::size_t static_models = 0;
+  for (const auto& [name, model] : registry_.models()) static_models += model.is_static ? 1 : 0;
+  const std::size_t awake = world_.AwakeBodyCount();
+  const std::size_t dynamic = registry_.size() - static_models;
+  ROS_INFO(
+      "sim time %.3f s, real-time factor %.2f%s, bodies %zu (%zu awake, %zu asleep, %zu static), "
+      "contacts %zu",
+      world_.time(), achieved, paused_ ? " (paused)" : "", registry_.size(), awake,
+      dynamic - std::min(awake, dynamic), static_models, world_.contacts().size());
+  status_wall_ = now;
+  status_sim_ = world_.time();
+}
+
+}  // namespace rigid_body_sim::node

@@ -1,0 +1,146 @@
+// What the node publishes: tf, model states, contacts and their markers, and
+// /clock, built under the world lock and sent after it is released.
+#include <string>
+#include <vector>
+
+#include <rosgraph_msgs/Clock.h>
+
+#include "rigid_body_sim/node/msg_conversion.h"
+#include "rigid_body_sim/node/names.h"
+#include "rigid_body_sim/node/sim_node.h"
+
+namespace rigid_body_sim::node {
+
+using physics::BodyId;
+using physics::FormatNumber;
+using physics::Pose;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+FrameState SimNode::RootStateLocked(const Model& model) const {
+  return FrameState{world_.GetPose(model.body), world_.GetLinearVelocity(model.body),
+                    world_.GetAngularVelocity(model.body)};
+}
+
+tf2_msgs::TFMessage SimNode::ModelTfLocked(const Model& model) const {
+  tf2_msgs::TFMessage tf;
+  const FrameState root = RootStateLocked(model);
+  const ros::Time stamp = SimTimeToRos(world_.time());
+  for (const io::LinkFrame& link : model.links) {
+    tf.transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
+                                           options_.world_frame,
+                                           FrameName(model.name, link.link_name), stamp));
+  }
+  return tf;
+}
+
+tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
+  tf2_msgs::TFMessage tf;
+  for (const auto& [name, model] : registry_.models()) {
+    if (!model.is_static) continue;
+    tf2_msgs::TFMessage model_tf = ModelTfLocked(model);
+    tf.transforms.insert(tf.transforms.end(), model_tf.transforms.begin(),
+                         model_tf.transforms.end());
+  }
+  return tf;
+}
+
+void SimNode::FillPeriodicLocked(Outbox* outbox) {
+  outbox->reset_count = reset_count_;
+  const double sim_time = world_.time();
+  const ros::Time stamp = SimTimeToRos(sim_time);
+
+  rigid_body_sim::ModelStates& states = outbox->states.emplace();
+  states.header.stamp = stamp;
+  states.header.frame_id = options_.world_frame;
+  states.name.reserve(registry_.size());
+  for (const auto& [name, model] : registry_.models()) {
+    const FrameState root = RootStateLocked(model);
+    for (const io::LinkFrame& link : model.links) {
+      const FrameState state = LinkStateFromRoot(root, link.root_from_link);
+      states.name.push_back(FrameName(name, link.link_name));
+      states.pose.push_back(PoseToMsg(state.world_from_frame));
+      states.twist.push_back(TwistToMsg(state.linear_velocity, state.angular_velocity));
+    }
+  }
+  // tf2 drops a transform whose stamp it already holds, so tf and contacts
+  // go out only when sim time moved.
+  if (sim_time == last_periodic_time_) return;
+  last_periodic_time_ = sim_time;
+
+  tf2_msgs::TFMessage& tf = outbox->tf.emplace();
+  tf.transforms.reserve(states.name.size());
+  for (const auto& [name, model] : registry_.models()) {
+    if (model.is_static) continue;
+    const FrameState root = RootStateLocked(model);
+    for (const io::LinkFrame& link : model.links) {
+      tf.transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
+                                             options_.world_frame, FrameName(name, link.link_name),
+                                             stamp));
+    }
+  }
+
+  // Every colliding contact since the last message, and the resting and
+  // separating contacts of the last step (its colliding ones are in the log).
+  std::vector<physics::ContactReport> contacts = world_.TakeCollisionLog();
+  for (const physics::ContactReport& contact : world_.contacts()) {
+    if (contact.type != physics::ContactType::kColliding) contacts.push_back(contact);
+  }
+  const auto body_name = [this](BodyId body, int shape) {
+    if (ground_ && body == *ground_) return std::string(names::kGroundName);
+    return registry_.ShapeFrame(body, shape);
+  };
+  rigid_body_sim::Contacts& contacts_msg = outbox->contacts.emplace();
+  contacts_msg.header.stamp = stamp;
+  contacts_msg.header.frame_id = options_.world_frame;
+  contacts_msg.contacts.reserve(contacts.size());
+  for (const physics::ContactReport& contact : contacts) {
+    contacts_msg.contacts.push_back(ContactToMsg(contact,
+                                                 body_name(contact.body_a, contact.shape_a),
+                                                 body_name(contact.body_b, contact.shape_b)));
+  }
+  ContactMarkerStyle style;
+  style.frame = options_.world_frame;
+  style.stamp = stamp;
+  style.force_scale = options_.contact_force_scale;
+  outbox->contact_markers = ContactMarkers(contacts, contact_marker_count_, style);
+  contact_marker_count_ = static_cast<int>(contacts.size());
+  if (options_.use_sim_time && sim_time > 0.0) outbox->clock = sim_time;
+}
+
+void SimNode::Publish(Outbox outbox) {
+  if (outbox.tf_static) tf_static_publisher_.publish(*outbox.tf_static);
+  if (outbox.tf && !outbox.tf->transforms.empty()) {
+    // A snapshot built before a step service's one may reach here after it;
+    // listeners would take the older poses as the latest, so it is dropped.
+    std::lock_guard<std::mutex> lock(publish_mutex_);
+    if (outbox.reset_count > tf_reset_count_) {
+      tf_reset_count_ = outbox.reset_count;
+      last_tf_stamp_ = ros::Time(0);
+    }
+    const ros::Time stamp = outbox.tf->transforms.front().header.stamp;
+    if (outbox.reset_count == tf_reset_count_ &&
+        (outbox.tf_is_new_frame || stamp >= last_tf_stamp_)) {
+      tf_publisher_.publish(*outbox.tf);
+      if (!outbox.tf_is_new_frame) last_tf_stamp_ = stamp;
+    }
+  }
+  if (outbox.states) states_publisher_.publish(*outbox.states);
+  if (outbox.contacts) contacts_publisher_.publish(*outbox.contacts);
+  if (outbox.contact_markers && !outbox.contact_markers->markers.empty()) {
+    contact_markers_publisher_.publish(*outbox.contact_markers);
+  }
+  if (outbox.body_markers) body_markers_publisher_.publish(*outbox.body_markers);
+  if (outbox.clock && options_.use_sim_time) {
+    std::lock_guard<std::mutex> lock(clock_mutex_);
+    if (*outbox.clock > last_clock_) {
+      rosgraph_msgs::Clock clock;
+      clock.clock = SimTimeToRos(*outbox.clock);
+      clock_publisher_.publish(clock);
+      last_clock_ = *outbox.clock;
+    }
+  }
+}
+
+}  // namespace rigid_body_sim::node
