@@ -64,7 +64,7 @@ Timing Run(const Scene& scene, int body_count, int steps, std::mt19937_64& rng) 
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   auto symmetric = [&]() { return 2.0 * unit(rng) - 1.0; };
   std::vector<MovingBox> boxes(body_count);
-  SweepAndSortBroadPhase broad_phase;
+  SortAndSweepBroadPhase broad_phase;
   std::vector<int> ids(body_count);
   for (int i = 0; i < body_count; ++i) {
     MovingBox& box = boxes[i];

@@ -169,6 +169,9 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
   }
 }
 
+// Baraff's order within a step: colliding contacts get impulses on the
+// velocities the step starts with, then the forces act, then the resting
+// contacts get the impulses that keep them apart, all contacts at once.
 void WorldImpl::SolveContacts(double dt) {
   // The bodies that move this step; the stages from here on visit only
   // them, so sleeping bodies cost nothing.
@@ -180,6 +183,36 @@ void WorldImpl::SolveContacts(double dt) {
   solver_.Reset(settings_.solver, dt, bodies_.size());
   const std::vector<ShapePairContact*>& pairs = contact_cache_.touching();
   LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
+  BuildSolverManifolds(pairs);
+  SeedNewSupportLoads(pairs, dt);
+  solver_.Prepare();
+
+  solver_.ResolveCollisions();
+  solver_.RecordStartVelocities();
+  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
+  IntegrateForces(settings_.gravity, dt, moving_bodies_, &bodies_);
+  DisableNonFiniteBodies();
+  LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
+  solver_.SolveRestingContacts();
+  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
+  // A body that resting contact pushed this step drifts with its end
+  // velocity (symplectic Euler), which keeps the momentum exchanged through
+  // contacts exactly conserved; the free ones keep the trapezoid's exact
+  // parabola (integrator.h).
+  for (const SolverManifold& manifold : solver_.manifolds()) {
+    for (int i = 0; i < manifold.point_count; ++i) {
+      if (manifold.points[i].normal_impulse <= 0.0) continue;
+      for (const std::uint32_t index : {manifold.body_a, manifold.body_b}) {
+        bodies_[index].start_linear_velocity = bodies_[index].linear_velocity;
+      }
+    }
+  }
+  ReportContacts(pairs, dt);
+}
+
+// One solver manifold per touching pair, with its points' lever arms,
+// combined materials and last step's impulses.
+void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs) {
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
   manifolds.reserve(pairs.size());
   for (std::size_t m = 0; m < pairs.size(); ++m) {
@@ -208,30 +241,12 @@ void WorldImpl::SolveContacts(double dt) {
       point.tangent_impulse = pair->warm_start[i].tangent_impulse;
     }
   }
-  SeedNewSupportLoads(pairs, dt);
-  solver_.Prepare();
+}
 
-  solver_.ResolveCollisions();
-  solver_.RecordStartVelocities();
-  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
-  IntegrateForces(settings_.gravity, dt, moving_bodies_, &bodies_);
-  DisableNonFiniteBodies();
-  LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
-  solver_.SolveRestingContacts();
-  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
-  // A body that resting contact pushed this step drifts with its end
-  // velocity (symplectic Euler), which keeps the momentum exchanged through
-  // contacts exactly conserved; the free ones keep the trapezoid's exact
-  // parabola (integrator.h).
-  for (const SolverManifold& manifold : manifolds) {
-    for (int i = 0; i < manifold.point_count; ++i) {
-      if (manifold.points[i].normal_impulse <= 0.0) continue;
-      for (const std::uint32_t index : {manifold.body_a, manifold.body_b}) {
-        bodies_[index].start_linear_velocity = bodies_[index].linear_velocity;
-      }
-    }
-  }
-
+// Keeps the impulses for next step's warm start, and reports the points
+// that touch, after the sleeping pairs' reports.
+void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt) {
+  const std::vector<SolverManifold>& manifolds = solver_.manifolds();
   // Sleeping bodies keep the contacts they fell asleep with; their reports
   // are made again only when the list of sleeping pairs changes.
   if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
@@ -248,8 +263,6 @@ void WorldImpl::SolveContacts(double dt) {
   }
   contacts_.resize(sleeping_report_count_);
 
-  // Keep the impulses for next step's warm start, and report the points
-  // that touch.
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
     const SolverManifold& manifold = manifolds[m];

@@ -61,7 +61,10 @@ class WorldImpl {
   void UpdateNarrowPhase(double dt);  // 2. narrow phase: manifolds per shape pair
   void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
   void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
-  void IntegrateBodies(double dt);    // 5. integrator: drift, time of impact, sleep
+  // Stage 4's parts (step_solver.cc).
+  void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
+  void ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt);
+  void IntegrateBodies(double dt);  // 5. integrator: drift, time of impact, sleep
   // Stage 5's parts (step_integrator.cc).
   void DriftBodies(double dt);
   void BoundBodyMotion(double dt);
