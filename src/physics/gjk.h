@@ -1,6 +1,6 @@
 // Distance between two convex point sets by GJK, independent of the
-// separating-axis code: the reference for narrow-phase tests and a distance
-// query for continuous collision.
+// separating-axis code: the reference the narrow-phase tests compare the
+// separating-axis test with. The simulation itself does not call it.
 #ifndef RIGID_BODY_SIM_PHYSICS_GJK_H_
 #define RIGID_BODY_SIM_PHYSICS_GJK_H_
 

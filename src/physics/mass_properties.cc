@@ -48,6 +48,71 @@ std::string FormatMatrix(const Mat3& m) {
   return out.str();
 }
 
+// Every index in range, no triangle repeats a vertex, and the surface is
+// closed: every directed edge (u, v) occurs exactly once and its reverse
+// (v, u) occurs too, so the surface has no boundary and is consistently
+// oriented.
+Status CheckClosedMesh(const TriangleMesh& mesh) {
+  const int vertex_count = static_cast<int>(mesh.vertices.size());
+  std::vector<std::pair<int, int>> directed_edges;
+  directed_edges.reserve(3 * mesh.triangles.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Eigen::Vector3i& triangle = mesh.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      if (triangle[k] < 0 || triangle[k] >= vertex_count) {
+        return Status::Error("triangle " + std::to_string(t) + " has vertex index " +
+                             std::to_string(triangle[k]) + " outside [0, " +
+                             std::to_string(vertex_count) + ")");
+      }
+    }
+    if (triangle[0] == triangle[1] || triangle[1] == triangle[2] || triangle[2] == triangle[0]) {
+      return Status::Error("triangle " + std::to_string(t) + " repeats a vertex index");
+    }
+    for (int k = 0; k < 3; ++k) directed_edges.emplace_back(triangle[k], triangle[(k + 1) % 3]);
+  }
+  std::sort(directed_edges.begin(), directed_edges.end());
+  for (std::size_t i = 0; i < directed_edges.size(); ++i) {
+    const auto& [from, to] = directed_edges[i];
+    if (i + 1 < directed_edges.size() && directed_edges[i + 1] == directed_edges[i]) {
+      return Status::Error("triangle mesh is not a 2-manifold: directed edge " +
+                           std::to_string(from) + "->" + std::to_string(to) +
+                           " is used by more than one triangle");
+    }
+    if (!std::binary_search(directed_edges.begin(), directed_edges.end(),
+                            std::make_pair(to, from))) {
+      return Status::Error("triangle mesh is open or inconsistently oriented: edge " +
+                           std::to_string(from) + "->" + std::to_string(to) +
+                           " has no reverse edge " + std::to_string(to) + "->" +
+                           std::to_string(from));
+    }
+  }
+
+  return Status::Ok();
+}
+
+// The mean of the vertices the triangles use (the moments are summed about
+// it, to avoid cancellation) and their bounding-box diagonal.
+void MeshReference(const TriangleMesh& mesh, Vec3* reference, double* extent) {
+  Vec3 lower = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 upper = -lower;
+  std::vector<bool> used(mesh.vertices.size(), false);
+  int used_count = 0;
+  *reference = Vec3::Zero();
+  for (const Eigen::Vector3i& triangle : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      if (used[triangle[k]]) continue;
+      used[triangle[k]] = true;
+      ++used_count;
+      const Vec3& p = mesh.vertices[triangle[k]];
+      *reference += p;
+      lower = lower.cwiseMin(p);
+      upper = upper.cwiseMax(p);
+    }
+  }
+  *reference /= used_count;
+  *extent = (upper - lower).norm();
+}
+
 }  // namespace
 
 // Solid box of edge lengths (a, b, c): m = rho a b c,
@@ -112,62 +177,10 @@ Result<MassProperties> TriangleMeshMassProperties(double density, const Triangle
     }
   }
 
-  // Closedness: every directed edge (u, v) occurs exactly once and its
-  // reverse (v, u) occurs too, so the surface has no boundary and is
-  // consistently oriented.
-  std::vector<std::pair<int, int>> directed_edges;
-  directed_edges.reserve(3 * mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Eigen::Vector3i& triangle = mesh.triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      if (triangle[k] < 0 || triangle[k] >= vertex_count) {
-        return Result<MassProperties>::Error("triangle " + std::to_string(t) +
-                                             " has vertex index " + std::to_string(triangle[k]) +
-                                             " outside [0, " + std::to_string(vertex_count) + ")");
-      }
-    }
-    if (triangle[0] == triangle[1] || triangle[1] == triangle[2] || triangle[2] == triangle[0]) {
-      return Result<MassProperties>::Error("triangle " + std::to_string(t) +
-                                           " repeats a vertex index");
-    }
-    for (int k = 0; k < 3; ++k) directed_edges.emplace_back(triangle[k], triangle[(k + 1) % 3]);
-  }
-  std::sort(directed_edges.begin(), directed_edges.end());
-  for (std::size_t i = 0; i < directed_edges.size(); ++i) {
-    const auto& [from, to] = directed_edges[i];
-    if (i + 1 < directed_edges.size() && directed_edges[i + 1] == directed_edges[i]) {
-      return Result<MassProperties>::Error("triangle mesh is not a 2-manifold: directed edge " +
-                                           std::to_string(from) + "->" + std::to_string(to) +
-                                           " is used by more than one triangle");
-    }
-    if (!std::binary_search(directed_edges.begin(), directed_edges.end(),
-                            std::make_pair(to, from))) {
-      return Result<MassProperties>::Error(
-          "triangle mesh is open or inconsistently oriented: edge " + std::to_string(from) + "->" +
-          std::to_string(to) + " has no reverse edge " + std::to_string(to) + "->" +
-          std::to_string(from));
-    }
-  }
-
-  Vec3 reference = Vec3::Zero();
-  Vec3 lower = Vec3::Constant(std::numeric_limits<double>::infinity());
-  Vec3 upper = -lower;
-  {
-    std::vector<bool> used(vertex_count, false);
-    int used_count = 0;
-    for (const Eigen::Vector3i& triangle : mesh.triangles) {
-      for (int k = 0; k < 3; ++k) {
-        if (used[triangle[k]]) continue;
-        used[triangle[k]] = true;
-        ++used_count;
-        const Vec3& p = mesh.vertices[triangle[k]];
-        reference += p;
-        lower = lower.cwiseMin(p);
-        upper = upper.cwiseMax(p);
-      }
-    }
-    reference /= used_count;
-  }
+  if (Status status = CheckClosedMesh(mesh); !status.ok()) return status;
+  Vec3 reference;
+  double extent = 0.0;
+  MeshReference(mesh, &reference, &extent);
 
   double volume = 0.0;
   Vec3 first_moment = Vec3::Zero();
@@ -184,7 +197,6 @@ Result<MassProperties> TriangleMeshMassProperties(double density, const Triangle
                                               c * c.transpose() + sum * sum.transpose());
   }
 
-  const double extent = (upper - lower).norm();
   if (!(std::abs(volume) > kRelativeVolumeTolerance * extent * extent * extent)) {
     std::ostringstream out;
     out << "triangle mesh encloses (almost) no volume: " << volume
