@@ -41,11 +41,21 @@ test: build
 deps:
 	@bash scripts/install_deps.sh
 
-$(WS)/src/rigid_body_sim:
-	mkdir -p $(WS)/src
-	ln -sfn $(ROOT) $(WS)/src/rigid_body_sim
+# The package in the workspace: a directory of links to the repository's
+# top-level entries, all but build/, so that nothing that follows links
+# (find -L, rosrun, rospack) walks from the workspace back into itself.
+# Refreshed on every build, so a new top-level entry is linked too.
+.PHONY: ws-links
+ws-links:
+	@if [ -L $(WS)/src/rigid_body_sim ]; then rm $(WS)/src/rigid_body_sim; fi
+	@mkdir -p $(WS)/src/rigid_body_sim
+	@for entry in $(ROOT)/* $(ROOT)/.clang-format; do \
+	  name=$$(basename $$entry); \
+	  [ "$$name" = build ] || ln -sfn $$entry $(WS)/src/rigid_body_sim/$$name; \
+	done
+	@find $(WS)/src/rigid_body_sim -maxdepth 1 -xtype l -delete
 
-build: deps $(WS)/src/rigid_body_sim
+build: deps ws-links
 	@echo "[build] catkin_make in $(WS)"
 	$(CATKIN) -j$(JOBS) 2>&1 | (grep --line-buffered -vE '^-- (Found|Looking|Detecting|Check|Performing|Using)' || true)
 
@@ -68,8 +78,7 @@ test-sanitize: deps
 # ThreadSanitizer in a second workspace; any report fails the target.
 WS_TSAN := $(ROOT)/build/.ws-tsan
 test-tsan: deps
-	mkdir -p $(WS_TSAN)/src
-	ln -sfn $(ROOT) $(WS_TSAN)/src/rigid_body_sim
+	$(MAKE) --no-print-directory ws-links WS=$(WS_TSAN)
 	catkin_make -C $(WS_TSAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
 	  -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread $(CMAKE_ARGS) \

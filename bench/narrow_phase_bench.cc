@@ -21,7 +21,6 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-
 struct Scene {
   const char* name;
   Pose world_from_a;

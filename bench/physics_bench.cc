@@ -432,14 +432,15 @@ std::string RunCommand(const std::string& command) {
   return output;
 }
 
-int Main(int argc, char** argv) {
-  const Options options = ParseOptions(argc, argv);
-  if (!options.error.empty()) {
-    std::fprintf(stderr, "physics_bench: %s\n", options.error.c_str());
-    return 2;
-  }
-  // Simulated seconds: 10 s as the scene list says, except the two largest
-  // scenes, which --scale shortens so a full run stays within minutes.
+// ns per contact row per solver iteration.
+double RowCostNs(const RunResult& result) {
+  const double rows = result.solver_point_iterations * result.rows_per_point;
+  return rows > 0.0 ? 1e6 * result.solver_rows_ms / rows : 0.0;
+}
+
+// The scenes of the run: every scene, or the ones --only names. Simulated
+// seconds: 10 s, except the two largest scenes, which --scale shortens.
+std::vector<Scene> SelectScenes(const Options& options) {
   std::vector<Scene> scenes = {
       MakePile(100, 10.0),   MakePile(1000, 10.0),  MakePile(4000, 10.0 * options.scale),
       MakePyramid(20, 10.0), MakePyramid(40, 10.0), MakePyramid(90, 10.0 * options.scale),
@@ -455,7 +456,10 @@ int Main(int argc, char** argv) {
                  scenes.end());
   }
 
-  const double window_seconds = 10.0 * options.scale;
+  return scenes;
+}
+
+void PrintHeader(const Options& options, double window_seconds) {
   if (options.scale != 1.0 || options.large_runs != options.runs) {
     std::printf(
         "scenes of 4,000 bodies and more: %.2f s of simulated time instead of 10 s, "
@@ -492,7 +496,13 @@ int Main(int argc, char** argv) {
   std::printf("%-11s %-6s %6s %6s %23s %9s %9s %10s %11s %15s %7s  %s\n", "scene", "engine",
               "bodies", "sim s", "ms/step med [min, max]", "steps/s", "ours/blt", "KE J", "pen mm",
               "peak pen mm", "RSS MB", "quality");
+}
 
+using Rows = std::vector<std::pair<Summary, Summary>>;  // (ours, bullet) per scene
+
+// Runs every scene in both engines and prints a row each.
+Rows MeasureScenes(const Options& options, const std::vector<Scene>& scenes,
+                   double window_seconds) {
   std::vector<std::pair<Summary, Summary>> rows;  // (ours, bullet) per scene
   for (const Scene& scene : scenes) {
     const int runs = IsLarge(scene) ? options.large_runs : options.runs;
@@ -516,7 +526,11 @@ int Main(int argc, char** argv) {
     rows.emplace_back(ours, bullet);
   }
 
-  // Stage profile and the cost of one contact row in one solver iteration.
+  return rows;
+}
+
+// Stage profile and the cost of one contact row in one solver iteration.
+void PrintStageProfile(const Rows& rows) {
   std::printf(
       "\nstage profile, ms per step (mean of the median run); solver ns per row-iteration "
       "= solver time of the steps with contacts / (point updates of the velocity iterations x "
@@ -527,21 +541,19 @@ int Main(int argc, char** argv) {
       "solve (the rest is free flight or asleep), ms/contact step = wall time of one of them\n");
   std::printf("%-11s %-6s %9s %9s %9s %9s %13s %10s %16s\n", "scene", "engine", "broad", "narrow",
               "solver", "integr", "ns/row-iter", "contact s", "ms/contact step");
-  auto row_cost_ns = [](const RunResult& result) {
-    const double rows = result.solver_point_iterations * result.rows_per_point;
-    return rows > 0.0 ? 1e6 * result.solver_rows_ms / rows : 0.0;
-  };
   for (const auto& [ours, bullet] : rows) {
     for (const Summary* summary : {&ours, &bullet}) {
       const RunResult& result = summary->median;
       std::printf("%-11s %-6s %9.3f %9.3f %9.3f %9.3f %13.1f %10.2f %16.3f\n",
                   summary->scene.c_str(), summary->engine.c_str(), result.broad_phase_ms,
-                  result.narrow_phase_ms, result.solver_ms, result.integrator_ms,
-                  row_cost_ns(result), result.contact_steps * kTimeStep, ContactStepMs(result));
+                  result.narrow_phase_ms, result.solver_ms, result.integrator_ms, RowCostNs(result),
+                  result.contact_steps * kTimeStep, ContactStepMs(result));
     }
   }
+}
 
-  // Scaling from pile_1000 to pile_4000.
+// Scaling from pile_1000 to pile_4000.
+void PrintScaling(const Rows& rows, double window_seconds) {
   const Summary* pile_1000[2] = {nullptr, nullptr};
   const Summary* pile_4000[2] = {nullptr, nullptr};
   for (const auto& row : rows) {
@@ -579,8 +591,9 @@ int Main(int argc, char** argv) {
     }
     std::printf("\n");
   }
+}
 
-  std::ofstream csv(options.csv_path);
+void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream& csv) {
   csv << "scene,engine,bodies,sim_seconds,steps,ms_per_step_median,ms_per_step_min,"
          "ms_per_step_max,steps_per_second,ratio_ours_over_bullet,final_kinetic_energy_j,"
          "final_penetration_m,peak_penetration_m,top_box_drift_m,bounce_apex_m,"
@@ -609,29 +622,45 @@ int Main(int argc, char** argv) {
           << (scene.kind == SceneKind::kIncline ? std::to_string(result.slide) : "") << ','
           << (scene.kind == SceneKind::kIncline ? std::to_string(quality.value) : "") << ','
           << result.broad_phase_ms << ',' << result.narrow_phase_ms << ',' << result.solver_ms
-          << ',' << result.integrator_ms << ',' << row_cost_ns(result) << ','
-          << summary->peak_rss_kb << ',' << result.contact_steps * kTimeStep << ','
-          << ContactStepMs(result) << '\n';
+          << ',' << result.integrator_ms << ',' << RowCostNs(result) << ',' << summary->peak_rss_kb
+          << ',' << result.contact_steps * kTimeStep << ',' << ContactStepMs(result) << '\n';
     }
   }
+}
 
-  if (!options.hull_bench.empty()) {
-    std::printf("\nhull: %s (our io library; Bullet has no mesh-to-hull pipeline to compare)\n",
-                options.hull_bench.c_str());
-    const std::string output = RunCommand(options.hull_bench);
-    std::printf("%s", output.c_str());
-    double load_ms = 0.0, hull_ms = 0.0, total_ms = 0.0;
-    const std::size_t at = output.find("best of");
-    if (at != std::string::npos &&
-        std::sscanf(output.c_str() + at, "best of %*d: load %lf ms, hull %lf ms, total %lf ms",
-                    &load_ms, &hull_ms, &total_ms) == 3) {
-      // Load and hull of one mesh: the "step" is the whole task (best of the
-      // program's repetitions, so min = median = max).
-      csv << "hull,ours,1,,1," << total_ms << ',' << total_ms << ',' << total_ms
-          << std::string(18, ',') << '\n';
-    }
+// Runs the hull benchmark and adds its row to the CSV.
+void RunHullBench(const std::string& hull_bench, std::ofstream& csv) {
+  std::printf("\nhull: %s (our io library; Bullet has no mesh-to-hull pipeline to compare)\n",
+              hull_bench.c_str());
+  const std::string output = RunCommand(hull_bench);
+  std::printf("%s", output.c_str());
+  double load_ms = 0.0, hull_ms = 0.0, total_ms = 0.0;
+  const std::size_t at = output.find("best of");
+  if (at != std::string::npos &&
+      std::sscanf(output.c_str() + at, "best of %*d: load %lf ms, hull %lf ms, total %lf ms",
+                  &load_ms, &hull_ms, &total_ms) == 3) {
+    // Load and hull of one mesh: the "step" is the whole task (best of the
+    // program's repetitions, so min = median = max).
+    csv << "hull,ours,1,,1," << total_ms << ',' << total_ms << ',' << total_ms
+        << std::string(18, ',') << '\n';
   }
+}
 
+int Main(int argc, char** argv) {
+  const Options options = ParseOptions(argc, argv);
+  if (!options.error.empty()) {
+    std::fprintf(stderr, "physics_bench: %s\n", options.error.c_str());
+    return 2;
+  }
+  const std::vector<Scene> scenes = SelectScenes(options);
+  const double window_seconds = 10.0 * options.scale;
+  PrintHeader(options, window_seconds);
+  const Rows rows = MeasureScenes(options, scenes, window_seconds);
+  PrintStageProfile(rows);
+  PrintScaling(rows, window_seconds);
+  std::ofstream csv(options.csv_path);
+  WriteCsv(scenes, rows, csv);
+  if (!options.hull_bench.empty()) RunHullBench(options.hull_bench, csv);
   std::printf("\nwrote %s\n", options.csv_path.c_str());
   return 0;
 }

@@ -12,7 +12,8 @@ packages=(
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
   libbullet-dev libbenchmark-dev python3-matplotlib
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
-  python3-geometry-msgs python3-std-msgs
+  python3-geometry-msgs python3-std-msgs python3-std-srvs python3-visualization-msgs
+  python3-rosgraph-msgs python3-tf2-msgs
 )
 
 missing=()

@@ -21,11 +21,11 @@ namespace rigid_body_sim::io {
 namespace {
 
 using physics::ConvexPolyhedron;
+using physics::FormatNumber;
 using physics::MassProperties;
 using physics::Mat3;
 using physics::Pose;
 using physics::Quat;
-using physics::FormatNumber;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;

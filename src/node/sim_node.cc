@@ -5,6 +5,8 @@
 #include <cassert>
 #include <utility>
 
+#include <rosgraph_msgs/Clock.h>
+
 #include "node/ros_uri.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
@@ -12,11 +14,8 @@
 namespace rigid_body_sim::node {
 
 using physics::BodyId;
-using physics::FormatNumber;
-using physics::Pose;
 using physics::Result;
 using physics::Status;
-using physics::Vec3;
 
 SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle private_node)
     : options_(std::move(options)),

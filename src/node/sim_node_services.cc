@@ -13,7 +13,6 @@ namespace rigid_body_sim::node {
 
 using physics::BodyId;
 using physics::FormatNumber;
-using physics::Pose;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;

@@ -12,11 +12,6 @@
 namespace rigid_body_sim::node {
 
 using physics::BodyId;
-using physics::FormatNumber;
-using physics::Pose;
-using physics::Result;
-using physics::Status;
-using physics::Vec3;
 
 FrameState SimNode::RootStateLocked(const Model& model) const {
   return FrameState{world_.GetPose(model.body), world_.GetLinearVelocity(model.body),

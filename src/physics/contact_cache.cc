@@ -10,6 +10,46 @@ namespace {
 // when their features differ. Resting points move far less in a step.
 constexpr double kPositionMatchDistance = 1e-3;
 
+// Each point of this step's manifold takes the impulses of last step's point
+// with the same features, else of the nearest unmatched one.
+void MatchWarmStarts(ShapePairContact* entry) {
+  std::array<bool, ContactManifold::kMaxPoints> taken{};  // previous points matched
+  std::array<bool, ContactManifold::kMaxPoints> found{};  // this step's points matched
+  for (int i = 0; i < entry->manifold.point_count; ++i) {
+    CachedImpulse& warm = entry->warm_start[i];
+    warm = CachedImpulse{entry->manifold.points[i].feature, 0.0, {0.0, 0.0}};
+    for (int k = 0; k < entry->previous_count; ++k) {
+      if (entry->previous[k].feature == warm.feature) {
+        warm = entry->previous[k];
+        taken[k] = found[i] = true;
+        break;
+      }
+    }
+  }
+  // A manifold clipped afresh can name the same contact by other features
+  // (two parallel faces: either may be the reference); such a point takes
+  // the impulses of the nearest unmatched point of last step within
+  // kPositionMatchDistance, as a persistent manifold matches by distance.
+  for (int i = 0; i < entry->manifold.point_count; ++i) {
+    if (found[i]) continue;
+    const Vec3& position = entry->manifold.points[i].position_world;
+    int nearest = -1;
+    double nearest_squared = kPositionMatchDistance * kPositionMatchDistance;
+    for (int k = 0; k < entry->previous_count; ++k) {
+      const double squared = (entry->previous[k].position_world - position).squaredNorm();
+      if (!taken[k] && squared < nearest_squared) {
+        nearest = k;
+        nearest_squared = squared;
+      }
+    }
+    if (nearest < 0) continue;
+    taken[nearest] = true;
+    CachedImpulse& warm = entry->warm_start[i];
+    warm.normal_impulse = entry->previous[nearest].normal_impulse;
+    warm.tangent_impulse = entry->previous[nearest].tangent_impulse;
+  }
+}
+
 }  // namespace
 
 // 20 bits per body slot and 12 per shape: up to a million bodies with up to
@@ -101,41 +141,7 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
       entry->previous_count = 0;
       continue;
     }
-    std::array<bool, ContactManifold::kMaxPoints> taken{};  // previous points matched
-    std::array<bool, ContactManifold::kMaxPoints> found{};  // this step's points matched
-    for (int i = 0; i < entry->manifold.point_count; ++i) {
-      CachedImpulse& warm = entry->warm_start[i];
-      warm = CachedImpulse{entry->manifold.points[i].feature, 0.0, {0.0, 0.0}};
-      for (int k = 0; k < entry->previous_count; ++k) {
-        if (entry->previous[k].feature == warm.feature) {
-          warm = entry->previous[k];
-          taken[k] = found[i] = true;
-          break;
-        }
-      }
-    }
-    // A manifold clipped afresh can name the same contact by other features
-    // (two parallel faces: either may be the reference); such a point takes
-    // the impulses of the nearest unmatched point of last step within
-    // kPositionMatchDistance, as a persistent manifold matches by distance.
-    for (int i = 0; i < entry->manifold.point_count; ++i) {
-      if (found[i]) continue;
-      const Vec3& position = entry->manifold.points[i].position_world;
-      int nearest = -1;
-      double nearest_squared = kPositionMatchDistance * kPositionMatchDistance;
-      for (int k = 0; k < entry->previous_count; ++k) {
-        const double squared = (entry->previous[k].position_world - position).squaredNorm();
-        if (!taken[k] && squared < nearest_squared) {
-          nearest = k;
-          nearest_squared = squared;
-        }
-      }
-      if (nearest < 0) continue;
-      taken[nearest] = true;
-      CachedImpulse& warm = entry->warm_start[i];
-      warm.normal_impulse = entry->previous[nearest].normal_impulse;
-      warm.tangent_impulse = entry->previous[nearest].tangent_impulse;
-    }
+    MatchWarmStarts(entry);
     keyed_.emplace_back(entry->key, entry);
   }
   // The solver's Gauss-Seidel order is the key order (body A's index first),

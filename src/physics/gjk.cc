@@ -181,19 +181,53 @@ int Support(const std::vector<Vec3>& points, const Vec3& direction) {
   return best;
 }
 
+std::vector<Vec3> ToWorld(const std::vector<Vec3>& points, const Pose& world_from_points) {
+  std::vector<Vec3> world(points.size());
+  for (std::size_t i = 0; i < world.size(); ++i) world[i] = world_from_points * points[i];
+  return world;
+}
+
+// Keeps the sub-simplex whose Voronoi region holds the origin, with the
+// barycentric weights of the origin's projection; false when a tetrahedron
+// contains the origin.
+bool ReduceSimplex(Simplex* simplex) {
+  switch (simplex->count) {
+    case 1:
+      Keep(simplex, {0}, {1.0});
+      return true;
+    case 2:
+      SolveSegment(simplex, 0, 1);
+      return true;
+    case 3:
+      SolveTriangle(simplex, 0, 1, 2);
+      return true;
+    default:
+      return SolveTetrahedron(simplex);
+  }
+}
+
+// The closest points on A and B, and their distance, from the weights of
+// the final simplex.
+void SetClosestPoints(const Simplex& simplex, GjkResult* result) {
+  result->point_a_world = Vec3::Zero();
+  result->point_b_world = Vec3::Zero();
+  for (int i = 0; i < simplex.count; ++i) {
+    result->point_a_world += simplex.weights[i] * simplex.vertices[i].a;
+    result->point_b_world += simplex.weights[i] * simplex.vertices[i].b;
+  }
+  Vec3 closest = Vec3::Zero();
+  for (int i = 0; i < simplex.count; ++i) closest += simplex.weights[i] * simplex.vertices[i].w;
+  result->distance = closest.norm();
+  result->simplex_count = simplex.count;
+}
+
 }  // namespace
 
 GjkResult GjkDistance(const GjkInput& input) {
   assert(input.points_a != nullptr && !input.points_a->empty());
   assert(input.points_b != nullptr && !input.points_b->empty());
-  std::vector<Vec3> a_world(input.points_a->size());
-  std::vector<Vec3> b_world(input.points_b->size());
-  for (std::size_t i = 0; i < a_world.size(); ++i) {
-    a_world[i] = input.world_from_a * (*input.points_a)[i];
-  }
-  for (std::size_t i = 0; i < b_world.size(); ++i) {
-    b_world[i] = input.world_from_b * (*input.points_b)[i];
-  }
+  const std::vector<Vec3> a_world = ToWorld(*input.points_a, input.world_from_a);
+  const std::vector<Vec3> b_world = ToWorld(*input.points_b, input.world_from_b);
 
   GjkResult result;
   Simplex simplex;
@@ -222,20 +256,7 @@ GjkResult GjkDistance(const GjkInput& input) {
     if (repeated) break;
 
     simplex.vertices[simplex.count++] = {w, support_a, support_b};
-    switch (simplex.count) {
-      case 1:
-        Keep(&simplex, {0}, {1.0});
-        break;
-      case 2:
-        SolveSegment(&simplex, 0, 1);
-        break;
-      case 3:
-        SolveTriangle(&simplex, 0, 1, 2);
-        break;
-      default:
-        overlapping = !SolveTetrahedron(&simplex);
-        break;
-    }
+    overlapping = !ReduceSimplex(&simplex);
     if (overlapping) break;
     v = Vec3::Zero();
     for (int i = 0; i < simplex.count; ++i) v += simplex.weights[i] * simplex.vertices[i].w;
@@ -256,18 +277,7 @@ GjkResult GjkDistance(const GjkInput& input) {
     result.distance = 0.0;
     return result;
   }
-  result.point_a_world = Vec3::Zero();
-  result.point_b_world = Vec3::Zero();
-  for (int i = 0; i < best_simplex.count; ++i) {
-    result.point_a_world += best_simplex.weights[i] * best_simplex.vertices[i].a;
-    result.point_b_world += best_simplex.weights[i] * best_simplex.vertices[i].b;
-  }
-  Vec3 closest = Vec3::Zero();
-  for (int i = 0; i < best_simplex.count; ++i) {
-    closest += best_simplex.weights[i] * best_simplex.vertices[i].w;
-  }
-  result.distance = closest.norm();
-  result.simplex_count = best_simplex.count;
+  SetClosestPoints(best_simplex, &result);
   return result;
 }
 

@@ -21,7 +21,6 @@ using physics::ConvexPolyhedron;
 using physics::kPi;
 using physics::Vec3;
 
-
 std::set<std::array<double, 3>> AsSet(const std::vector<Vec3>& points) {
   std::set<std::array<double, 3>> set;
   for (const Vec3& p : points) set.insert({p.x(), p.y(), p.z()});

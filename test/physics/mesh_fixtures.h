@@ -16,7 +16,6 @@
 
 namespace rigid_body_sim::physics::testing {
 
-
 // Makes every triangle counter-clockwise seen from outside, for a convex
 // mesh containing the origin: there the outward normal n of a face
 // satisfies n . p > 0 for any point p of the face.
