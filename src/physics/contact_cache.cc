@@ -10,6 +10,8 @@ namespace {
 // when their features differ. Resting points move far less in a step.
 constexpr double kPositionMatchDistance = 1e-3;
 
+}  // namespace
+
 // Each point of this step's manifold takes the impulses of last step's point
 // with the same features, else of the nearest unmatched one.
 void MatchWarmStarts(ShapePairContact* entry) {
@@ -49,8 +51,6 @@ void MatchWarmStarts(ShapePairContact* entry) {
     warm.tangent_impulse = entry->previous[nearest].tangent_impulse;
   }
 }
-
-}  // namespace
 
 // 20 bits per body slot and 12 per shape: up to a million bodies with up to
 // 4096 shapes each.

@@ -157,6 +157,10 @@ class ContactCache {
   bool frozen_changed_ = false;  // frozen_ differs from sleeping_
 };
 
+// Each point of `entry`'s manifold takes last step's impulses of the point
+// with the same features, else of the nearest unmatched one (warm start).
+void MatchWarmStarts(ShapePairContact* entry);
+
 }  // namespace rigid_body_sim::physics
 
 #endif  // RIGID_BODY_SIM_PHYSICS_CONTACT_CACHE_H_

@@ -43,6 +43,7 @@ void ContactSolver::Prepare() {
       if (point.separation > settings_.contact_tolerance) {
         // Apart now, but an inelastic point (a speculative row) whose
         // approach closes the gap within the step collides in this step.
+        // It is reported as a collision only if its row takes an impulse.
         const bool meets = manifold.restitution <= 0.0 && point.normal_velocity_before < -epsilon &&
                            -point.normal_velocity_before * time_step_ >= point.separation;
         point.type = meets ? ContactType::kColliding : ContactType::kSeparating;

@@ -18,6 +18,7 @@
 #include "physics/integrator.h"
 
 #include <cassert>
+#include <cmath>
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -68,6 +69,28 @@ Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_prin
       QuaternionRate(q0 + dt * k3, inverse_principal_moments, angular_momentum_world);
   const Eigen::Vector4d q1 = q0 + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   return Quat(q1[0], q1[1], q1[2], q1[3]).normalized();
+}
+
+Vec3 TurnBetween(const Quat& from, const Quat& to, const Vec3& guess) {
+  Eigen::AngleAxisd shortest(to * from.conjugate());
+  Vec3 axis = shortest.axis();
+  double angle = shortest.angle();  // [0, pi] once the axis is flipped to match
+  if (angle > kPi) {
+    angle = 2.0 * kPi - angle;
+    axis = -axis;
+  }
+  if (angle == 0.0) {
+    // Whole turns only, about the guess's axis.
+    const double guess_angle = guess.norm();
+    const double turns = std::round(guess_angle / (2.0 * kPi));
+    if (guess_angle == 0.0) return Vec3::Zero();
+    return Vec3(guess * (turns * 2.0 * kPi / guess_angle));
+  }
+  // The angle about `axis` that the guess turns, and the whole turns to add
+  // so the result lies nearest to it.
+  const double along = guess.dot(axis);
+  const double turns = std::round((along - angle) / (2.0 * kPi));
+  return axis * (angle + turns * 2.0 * kPi);
 }
 
 void IntegrateForces(const Vec3& gravity, double dt, const std::vector<std::uint32_t>& moving,

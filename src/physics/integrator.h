@@ -11,14 +11,18 @@
 namespace rigid_body_sim::physics {
 
 // Where a body is at time t in [0, dt] of the step: the position follows the
-// trapezoidal drift exactly (a parabola between the two velocities), the
-// orientation is interpolated by slerp.
+// trapezoidal drift exactly (a parabola between the two velocities); the
+// orientation turns at a constant rate about one axis from start to end,
+// by the rotation vector `turn`, which may exceed half a turn: a small body
+// can spin a full turn in one step, where slerp would take the short way
+// back.
 struct BodyPath {
   Pose start;                           // world_from_principal at t = 0
   Pose end;                             // at t = dt
   Vec3 start_velocity = Vec3::Zero();   // m/s, after the collision impulses
   Vec3 end_velocity = Vec3::Zero();     // m/s
   Vec3 pseudo_velocity = Vec3::Zero();  // m/s
+  Vec3 turn = Vec3::Zero();             // rad, world; end.rotation = exp(turn) start.rotation
   double dt = 0.0;                      // s; 0 for a body that does not move
   bool fast = false;                    // sampled along its path
   double reach = 0.0;                   // m, the furthest any point moves
@@ -28,13 +32,20 @@ struct BodyPath {
     Pose pose;
     pose.translation = start.translation + t * start_velocity +
                        0.5 * t * t / dt * (end_velocity - start_velocity) + t * pseudo_velocity;
-    pose.rotation = start.rotation.slerp(s, end.rotation);
+    const double angle = turn.norm();
+    pose.rotation = angle > 0.0 ? Quat(Eigen::AngleAxisd(s * angle, turn / angle)) * start.rotation
+                                : start.rotation;
     return pose;
   }
   Vec3 VelocityAt(double t) const {
     return start_velocity + (t / dt) * (end_velocity - start_velocity);
   }
 };
+
+// The rotation vector that turns `from` into `to`, of the winding (the
+// number of whole turns added to the shortest angle) closest to `guess`,
+// the rotation vector the angular velocity alone would give.
+Vec3 TurnBetween(const Quat& from, const Quat& to, const Vec3& guess);
 
 // Kick: P += (F + M g) dt and L += tau dt for the awake bodies of `moving`, then
 // clears the force and torque accumulators. Records v before the kick for

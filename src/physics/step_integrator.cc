@@ -73,9 +73,9 @@ struct ImpactBracket {
 // BIT 11, 1971). It ends when `low` is within a tenth of the touching band
 // above target_gap, so the free flight is cut short by at most that much,
 // or when the bracket is within tolerance, as plain bisection would.
-// Returns the legal end, low.
-double NarrowImpactBracket(const PairSweep& sweep, double target_gap, double touching, double dt,
-                           ImpactBracket bracket) {
+// Returns the narrowed bracket, whose legal end is `low`.
+ImpactBracket NarrowImpactBracket(const PairSweep& sweep, double target_gap, double touching,
+                                  double dt, ImpactBracket bracket) {
   const double close_enough = target_gap + 0.1 * (touching - target_gap);
   const double aim = target_gap + 0.05 * (touching - target_gap);
   int kept_side = 0;  // -1: low was kept last time, +1: high
@@ -102,7 +102,7 @@ double NarrowImpactBracket(const PairSweep& sweep, double target_gap, double tou
       kept_side = -1;
     }
   }
-  return bracket.low;
+  return bracket;
 }
 
 }  // namespace
@@ -119,13 +119,7 @@ double NarrowImpactBracket(const PairSweep& sweep, double target_gap, double tou
 void WorldImpl::IntegrateBodies(double dt) {
   DriftBodies(dt);
   BoundBodyMotion(dt);
-  BackUpToImpacts(dt);
-  // Outside this stage every path reads as a body that does not move.
-  for (const std::uint32_t i : moving_bodies_) {
-    paths_[i].dt = 0.0;
-    paths_[i].fast = false;
-    paths_[i].reach = 0.0;
-  }
+  ResolveImpacts(dt, FindImpacts(dt, contact_cache_.seen()), contact_cache_.touching(), 0);
   UpdateSleep(dt);
 }
 
@@ -148,7 +142,11 @@ void WorldImpl::DriftBodies(double dt) {
   DisableNonFiniteBodies();
   for (const std::uint32_t i : moving_bodies_) {
     if (bodies_[i].disabled) paths_[i].dt = 0.0;
-    if (paths_[i].dt > 0.0) paths_[i].end = bodies_[i].WorldFromPrincipal();
+    BodyPath& path = paths_[i];
+    if (path.dt == 0.0) continue;
+    path.end = bodies_[i].WorldFromPrincipal();
+    path.turn =
+        TurnBetween(path.start.rotation, path.end.rotation, dt * bodies_[i].angular_velocity);
   }
 }
 
@@ -162,7 +160,7 @@ void WorldImpl::BoundBodyMotion(double dt) {
   for (const std::uint32_t i : moving_bodies_) {
     BodyPath& path = paths_[i];
     if (path.dt == 0.0) continue;
-    const double angle = path.start.rotation.angularDistance(path.end.rotation);
+    const double angle = path.turn.norm();
     const double radius = bodies_[i].bounding_radius;
     const double displacement = (path.end.translation - path.start.translation).norm();
     path.fast =
@@ -176,39 +174,29 @@ void WorldImpl::BoundBodyMotion(double dt) {
 
 // Candidate pairs: a pair with no touching point at the start (a new
 // contact, which the solver has not seen), and every pair of a fast body;
-// pairs already touching are the resting solver's. Each body is backed up
-// to its own earliest impact. Backing up whole groups of linked impacts
-// instead would let one grazing pair hold every body of a pile at the start
-// of its step, step after step.
-void WorldImpl::BackUpToImpacts(double dt) {
-  std::vector<double> impact_time(bodies_.size(), std::numeric_limits<double>::infinity());
-  const std::vector<ShapePairContact*>& seen = contact_cache_.seen();
-  for (std::size_t e = 0; e < seen.size(); ++e) {
-    PrefetchAhead(seen, e, PrefetchManifold);
-    ShapePairContact* pair = seen[e];
-    const double time = PairImpactTime(dt, pair);
-    impact_time[pair->body_a] = std::min(impact_time[pair->body_a], time);
-    impact_time[pair->body_b] = std::min(impact_time[pair->body_b], time);
+// pairs already touching are the resting solver's.
+std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs) {
+  std::vector<Impact> impacts;
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    PrefetchAhead(pairs, e, PrefetchManifold);
+    ShapePairContact* pair = pairs[e];
+    if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) continue;
+    double approach_speed = 0.0;
+    const double time = PairImpactTime(dt, pair, &approach_speed);
+    if (!std::isfinite(time)) continue;
+    const bool colliding = approach_speed > settings_.solver.collision_velocity_threshold;
+    impacts.push_back(Impact{pair, time, colliding});
   }
-  for (const std::uint32_t i : moving_bodies_) {
-    const double time = impact_time[i];
-    if (!std::isfinite(time) || paths_[i].dt == 0.0) continue;
-    Body& body = bodies_[i];
-    const Pose pose = paths_[i].At(time);
-    body.position = pose.translation;
-    body.orientation = pose.rotation.normalized();
-    body.linear_momentum = body.mass * paths_[i].VelocityAt(time);
-    body.UpdateDerived();
-    body.start_linear_velocity = body.linear_velocity;
-  }
+  return impacts;
 }
 
 // The time within the step at which the pair comes within the touching band,
 // or +infinity when it does not or is already in contact.
-double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair) {
+double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* approach_speed) {
   constexpr double kNoImpact = std::numeric_limits<double>::infinity();
-  const double touching = settings_.solver.contact_tolerance;
-  const double target_gap = 0.5 * touching;
+  *approach_speed = 0.0;
+  double touching = settings_.solver.contact_tolerance;
+  double target_gap = 0.5 * touching;
   const BodyPath& path_a = paths_[pair->body_a];
   const BodyPath& path_b = paths_[pair->body_b];
   // The gap at the start: the nearest point of the manifold, or, with no
@@ -224,6 +212,18 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair) {
   const bool fast = path_a.fast || path_b.fast;
   if (start_gap <= touching && !fast) return kNoImpact;
   if (bodies_[pair->body_a].disabled || bodies_[pair->body_b].disabled) return kNoImpact;
+  if (start_gap <= touching) {
+    // Already in contact, and fast (a small body spinning on a corner): the
+    // solver holds the points it touches at, and the search only keeps
+    // another feature from passing through the other body. Backing up to
+    // the first touch of a feature would return t = 0 step after step and
+    // freeze the body in place with its velocity. The depth allowed is the
+    // motion per sample of a fast body, so nothing thicker than four times
+    // it can be passed through.
+    const double depth = settings_.continuous_fraction * PairThickness(*pair);
+    touching = start_gap - 0.5 * depth;
+    target_gap = start_gap - depth;
+  }
   // Two bodies that cannot close their gap within the step need no search
   // (a reused manifold's gap is known to within its reuse error).
   const double reach = path_a.reach + path_b.reach;
@@ -266,7 +266,20 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair) {
   // by its reuse error, and a pair backed up to t = 0 again and again would
   // never reach the solver).
   pair->anchors.valid = false;
-  return NarrowImpactBracket(sweep, target_gap, touching, dt, bracket);
+  bracket = NarrowImpactBracket(sweep, target_gap, touching, dt, bracket);
+  // The gap's rate over the final bracket: the speed the surfaces meet at.
+  *approach_speed = (bracket.gap_low - bracket.gap_high) / (bracket.high - bracket.low);
+  return bracket.low;
+}
+
+// m; the thinner moving body of the pair (a static one never moves through
+// anything).
+double WorldImpl::PairThickness(const ShapePairContact& pair) const {
+  double thickness = std::numeric_limits<double>::infinity();
+  for (const std::uint32_t index : {pair.body_a, pair.body_b}) {
+    if (paths_[index].dt > 0.0) thickness = std::min(thickness, bodies_[index].thickness);
+  }
+  return thickness;
 }
 
 // Samples along the faster body's path, so that no sample moves it more than
@@ -276,8 +289,10 @@ int WorldImpl::PathSamples(std::uint32_t body_a, std::uint32_t body_b) const {
   for (const std::uint32_t index : {body_a, body_b}) {
     const BodyPath& path = paths_[index];
     if (path.dt == 0.0) continue;
-    motion = std::max(motion, (path.end.translation - path.start.translation).norm() /
-                                  (settings_.continuous_fraction * bodies_[index].thickness));
+    const double displacement = (path.end.translation - path.start.translation).norm() +
+                                path.turn.norm() * bodies_[index].bounding_radius;
+    motion =
+        std::max(motion, displacement / (settings_.continuous_fraction * bodies_[index].thickness));
   }
   return static_cast<int>(std::clamp(std::ceil(motion), 1.0, kMaxPathSamples));
 }

@@ -180,8 +180,15 @@ void WorldImpl::SolveContacts(double dt) {
     const Body& body = bodies_[i];
     if (body.in_use && !body.is_static && body.awake && !body.disabled) moving_bodies_.push_back(i);
   }
-  solver_.Reset(settings_.solver, dt, bodies_.size());
   const std::vector<ShapePairContact*>& pairs = contact_cache_.touching();
+  SolveTouching(dt, pairs);
+  ReportContacts(pairs, dt, /*impacts_only=*/false);
+}
+
+// The contact solve of the touching pairs over dt, for the bodies of
+// moving_bodies_; the others are held where they are.
+void WorldImpl::SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs) {
+  solver_.Reset(settings_.solver, dt, bodies_.size());
   LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
   BuildSolverManifolds(pairs);
   SeedNewSupportLoads(pairs, dt);
@@ -207,7 +214,6 @@ void WorldImpl::SolveContacts(double dt) {
       }
     }
   }
-  ReportContacts(pairs, dt);
 }
 
 // One solver manifold per touching pair, with its points' lever arms,
@@ -245,10 +251,46 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
 
 // Keeps the impulses for next step's warm start, and reports the points
 // that touch, after the sleeping pairs' reports.
-void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt) {
+void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt,
+                               bool impacts_only) {
   const std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  // Sleeping bodies keep the contacts they fell asleep with; their reports
-  // are made again only when the list of sleeping pairs changes.
+  if (!impacts_only) ReportSleepingContacts(dt);
+  for (std::size_t m = 0; m < manifolds.size(); ++m) {
+    PrefetchAhead(pairs, m, PrefetchPoints);
+    const SolverManifold& manifold = manifolds[m];
+    ShapePairContact& pair = *pairs[m];
+    pair.previous_count = manifold.point_count;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      const SolverPoint& point = manifold.points[i];
+      pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse,
+                                       pair.manifold.points[i].position_world};
+      const bool touching = point.separation <= settings_.solver.contact_tolerance;
+      const double impulse = point.collision_impulse + point.normal_impulse;
+      // A collision is reported only where an impulse resolved it; a
+      // sub-step after an impact reports only its collisions, the step's
+      // own report holding the resting contacts.
+      const bool collided = point.type == ContactType::kColliding && impulse > 0.0;
+      const bool reported = point.type == ContactType::kColliding ? collided : touching;
+      if (!reported || (impacts_only && !collided)) continue;
+      ContactReport& report =
+          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, dt));
+      report.normal_velocity = point.normal_velocity_before;
+      report.type = point.type;
+      report.normal_impulse = impulse;
+      report.normal_force = report.normal_impulse / dt;
+      if (report.type == ContactType::kColliding) collision_log_.push_back(report);
+    }
+  }
+  if (collision_log_.size() > kMaxCollisionLogSize) {
+    collision_log_.erase(collision_log_.begin(),
+                         collision_log_.end() - static_cast<std::ptrdiff_t>(kMaxCollisionLogSize));
+  }
+}
+
+// Sleeping bodies keep the contacts they fell asleep with; their reports are
+// made again only when the list of sleeping pairs changes, and the reports
+// of this step follow them.
+void WorldImpl::ReportSleepingContacts(double dt) {
   if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
     contacts_.clear();
     for (const ShapePairContact* pair : contact_cache_.sleeping()) {
@@ -262,31 +304,6 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, doub
     sleeping_report_count_ = contacts_.size();
   }
   contacts_.resize(sleeping_report_count_);
-
-  for (std::size_t m = 0; m < manifolds.size(); ++m) {
-    PrefetchAhead(pairs, m, PrefetchPoints);
-    const SolverManifold& manifold = manifolds[m];
-    ShapePairContact& pair = *pairs[m];
-    pair.previous_count = manifold.point_count;
-    for (int i = 0; i < manifold.point_count; ++i) {
-      const SolverPoint& point = manifold.points[i];
-      pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse,
-                                       pair.manifold.points[i].position_world};
-      const bool touching = point.separation <= settings_.solver.contact_tolerance;
-      if (!touching && point.type != ContactType::kColliding) continue;
-      ContactReport& report =
-          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, dt));
-      report.normal_velocity = point.normal_velocity_before;
-      report.type = point.type;
-      report.normal_impulse = point.collision_impulse + point.normal_impulse;
-      report.normal_force = report.normal_impulse / dt;
-      if (report.type == ContactType::kColliding) collision_log_.push_back(report);
-    }
-  }
-  if (collision_log_.size() > kMaxCollisionLogSize) {
-    collision_log_.erase(collision_log_.begin(),
-                         collision_log_.end() - static_cast<std::ptrdiff_t>(kMaxCollisionLogSize));
-  }
 }
 
 }  // namespace rigid_body_sim::physics

@@ -22,6 +22,13 @@
 
 namespace rigid_body_sim::physics {
 
+// A pair that comes into contact within a (sub)step, and when.
+struct Impact {
+  ShapePairContact* pair = nullptr;
+  double time = 0.0;       // s from the (sub)step's start
+  bool colliding = false;  // the surfaces meet faster than collision_velocity_threshold
+};
+
 // The public methods do what World's of the same name are documented to do.
 class WorldImpl {
  public:
@@ -62,15 +69,25 @@ class WorldImpl {
   void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
   void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
   // Stage 4's parts (step_solver.cc).
+  void SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs);
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
-  void ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt);
+  void ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt, bool impacts_only);
+  void ReportSleepingContacts(double dt);
   void IntegrateBodies(double dt);  // 5. integrator: drift, time of impact, sleep
-  // Stage 5's parts (step_integrator.cc).
+  // Stage 5's parts (step_integrator.cc, step_impacts.cc).
   void DriftBodies(double dt);
   void BoundBodyMotion(double dt);
-  void BackUpToImpacts(double dt);
-  double PairImpactTime(double dt, ShapePairContact* pair);
+  std::vector<Impact> FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs);
+  // Time of impact within dt, or +infinity; with the speed the surfaces
+  // meet at, m/s.
+  double PairImpactTime(double dt, ShapePairContact* pair, double* approach_speed);
+  void ResolveImpacts(double h, const std::vector<Impact>& impacts,
+                      const std::vector<ShapePairContact*>& touching, int round);
+  void BackUpBody(std::uint32_t index, double time);
+  void SubStep(const std::vector<std::uint32_t>& island, double h, int round);
+  void RecollidePair(double h, ShapePairContact* pair);
   int PathSamples(std::uint32_t body_a, std::uint32_t body_b) const;
+  double PairThickness(const ShapePairContact& pair) const;
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
   double ContactDistance(const Body& a, const Body& b, double dt) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
