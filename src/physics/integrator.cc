@@ -48,25 +48,31 @@ Quat Rotated(const Quat& q, const Vec3& rotation_vector) {
 }  // namespace
 
 Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_principal_moments,
-                      const Vec3& angular_momentum_world, double dt) {
-  // Isotropic inertia (I = k 1: a sphere, a cube): omega = L / k is the same
-  // in every orientation, so it is constant over the step and q' = 1/2 omega q
-  // has the closed form q(dt) = exp(1/2 omega dt) q, a rotation by |omega| dt
-  // about omega. Exact, and cheaper than RK4's four rates.
+                      const Vec3& start_angular_momentum, const Vec3& end_angular_momentum,
+                      double dt) {
+  // Isotropic inertia (I = k 1: a sphere, a cube): omega = L / k whatever the
+  // orientation. A constant torque changes L linearly over the step, so
+  // omega is linear in t; about a fixed axis the turn is then exactly
+  // dt (omega_start + omega_end) / 2, the closed form of a spin-up under
+  // constant torque. Without torque this is the exact rotation by omega dt.
   if (inverse_principal_moments.x() == inverse_principal_moments.y() &&
       inverse_principal_moments.y() == inverse_principal_moments.z()) {
-    const Vec3 omega_world = inverse_principal_moments.x() * angular_momentum_world;
-    return Rotated(world_from_principal, dt * omega_world);
+    const Vec3 mean_momentum = 0.5 * (start_angular_momentum + end_angular_momentum);
+    return Rotated(world_from_principal, dt * inverse_principal_moments.x() * mean_momentum);
   }
+  // RK4 on q' = 1/2 omega(q, L(t)) q with L(t) linear between the step's
+  // ends: fourth order for a constant torque as for none.
+  const Vec3 change = end_angular_momentum - start_angular_momentum;
+  const Vec3 mid_momentum = start_angular_momentum + 0.5 * change;
   const Eigen::Vector4d q0(world_from_principal.w(), world_from_principal.x(),
                            world_from_principal.y(), world_from_principal.z());
-  const Eigen::Vector4d k1 = QuaternionRate(q0, inverse_principal_moments, angular_momentum_world);
+  const Eigen::Vector4d k1 = QuaternionRate(q0, inverse_principal_moments, start_angular_momentum);
   const Eigen::Vector4d k2 =
-      QuaternionRate(q0 + 0.5 * dt * k1, inverse_principal_moments, angular_momentum_world);
+      QuaternionRate(q0 + 0.5 * dt * k1, inverse_principal_moments, mid_momentum);
   const Eigen::Vector4d k3 =
-      QuaternionRate(q0 + 0.5 * dt * k2, inverse_principal_moments, angular_momentum_world);
+      QuaternionRate(q0 + 0.5 * dt * k2, inverse_principal_moments, mid_momentum);
   const Eigen::Vector4d k4 =
-      QuaternionRate(q0 + dt * k3, inverse_principal_moments, angular_momentum_world);
+      QuaternionRate(q0 + dt * k3, inverse_principal_moments, end_angular_momentum);
   const Eigen::Vector4d q1 = q0 + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   return Quat(q1[0], q1[1], q1[2], q1[3]).normalized();
 }
@@ -100,6 +106,7 @@ void IntegrateForces(const Vec3& gravity, double dt, const std::vector<std::uint
     Body& body = (*bodies)[i];
     if (!body.in_use || body.is_static || !body.awake) continue;
     body.start_linear_velocity = body.linear_velocity;
+    body.start_angular_momentum = body.angular_momentum;
     body.linear_momentum += (body.mass * gravity + body.force) * dt;
     body.angular_momentum += body.torque * dt;
     body.force.setZero();
@@ -115,15 +122,16 @@ void IntegratePositions(double dt, const std::vector<std::uint32_t>& moving,
     if (!body.in_use || body.is_static || !body.awake) continue;
     body.position += 0.5 * dt * (body.start_linear_velocity + body.linear_velocity) +
                      dt * body.pseudo_linear_velocity;
-    if (!body.angular_momentum.isZero(0.0)) {
+    if (!body.angular_momentum.isZero(0.0) || !body.start_angular_momentum.isZero(0.0)) {
       body.orientation = DriftOrientation(body.orientation, body.inverse_principal_moments,
-                                          body.angular_momentum, dt);
+                                          body.start_angular_momentum, body.angular_momentum, dt);
     }
     if (!body.pseudo_angular_velocity.isZero(0.0)) {
       // The split-impulse rotation, a small angle applied as an exact rotation.
       body.orientation = Rotated(body.orientation, dt * body.pseudo_angular_velocity);
     }
     body.start_linear_velocity = body.linear_velocity;
+    body.start_angular_momentum = body.angular_momentum;
     body.pseudo_linear_velocity.setZero();
     body.pseudo_angular_velocity.setZero();
     body.UpdateDerived();

@@ -58,12 +58,14 @@ void IntegrateForces(const Vec3& gravity, double dt, const std::vector<std::uint
 void IntegratePositions(double dt, const std::vector<std::uint32_t>& moving,
                         std::vector<Body>* bodies);
 
-// Orientation after dt of torque-free motion with world angular momentum L
-// held constant: RK4 on q' = 1/2 (0, omega(q)) q, omega(q) = R(q) I^-1 R(q)^T L;
-// exactly, as a rotation by the constant omega = I^-1 L, when the three
-// principal moments are equal.
+// Orientation after dt with the world angular momentum L going linearly
+// from its start to its end value (a constant torque, or none): RK4 on
+// q' = 1/2 (0, omega(q, t)) q, omega = R(q) I^-1 R(q)^T L(t); exactly, as a
+// rotation by dt times the mean omega, when the three principal moments are
+// equal (exact for a torque about a fixed axis).
 Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_principal_moments,
-                      const Vec3& angular_momentum_world, double dt);
+                      const Vec3& start_angular_momentum, const Vec3& end_angular_momentum,
+                      double dt);
 
 }  // namespace rigid_body_sim::physics
 

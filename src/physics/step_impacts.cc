@@ -22,6 +22,12 @@ namespace {
 // step; later ones keep the bodies at their time of impact, as the step
 // does for an impact that is not a collision (a resting body grazed).
 constexpr int kMaxImpactRounds = 8;
+// Islands of more bodies than this keep their bodies at their times of
+// impact, as before the rest of the step was simulated: a box landing on a
+// settling pile of a thousand would have the whole pile stepped again, and
+// the position lost is at most the approach speed times the rest of the
+// step for the landing box only.
+constexpr std::size_t kMaxSubStepBodies = 32;
 
 }  // namespace
 
@@ -62,6 +68,14 @@ void WorldImpl::ResolveImpacts(double h, const std::vector<Impact>& impacts,
         root_collides[root] |= impact.colliding && round < kMaxImpactRounds;
       }
     }
+    std::vector<std::uint32_t> island_size(bodies_.size(), 0);
+    for (const std::uint32_t body : moving) {
+      if (moves(body)) ++island_size[sets.Find(body)];
+    }
+    for (const std::uint32_t body : moving) {
+      const std::uint32_t root = moves(body) ? sets.Find(body) : body;
+      if (island_size[root] > kMaxSubStepBodies) root_collides[root] = 0;
+    }
     std::vector<int> island_of_root(bodies_.size(), -1);
     for (const std::uint32_t body : moving) {
       if (!moves(body)) continue;
@@ -97,6 +111,7 @@ void WorldImpl::BackUpBody(std::uint32_t index, double time) {
   body.linear_momentum = body.mass * path.VelocityAt(time);
   body.UpdateDerived();
   body.start_linear_velocity = body.linear_velocity;
+  body.start_angular_momentum = body.angular_momentum;
 }
 
 // `island` (moving bodies at one time) simulates h as a step of its own

@@ -202,16 +202,49 @@ void WorldImpl::SolveTouching(double dt, const std::vector<ShapePairContact*>& p
   LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
   solver_.SolveRestingContacts();
   StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
-  // A body that resting contact pushed this step drifts with its end
-  // velocity (symplectic Euler), which keeps the momentum exchanged through
-  // contacts exactly conserved; the free ones keep the trapezoid's exact
-  // parabola (integrator.h).
+  HoldPushedBodies();
+}
+
+// A body that resting contact pushed this step drifts with its end velocity
+// along the contact normal (symplectic Euler), so it does not sink while
+// held; across the normal it keeps the trapezoid, dt/2 (v_start + v_end),
+// exact for a constant force such as kinetic friction on a sliding box
+// (integrator.h). A body pushed along two directions that are not parallel
+// (a box in a corner, one in a stack leaning on a neighbour) drifts with its
+// end velocity and its end angular momentum throughout.
+void WorldImpl::HoldPushedBodies() {
+  constexpr double kParallelSine = 1e-9;
+  push_normals_.resize(bodies_.size());
+  push_state_.assign(bodies_.size(), 0);
   for (const SolverManifold& manifold : solver_.manifolds()) {
-    for (int i = 0; i < manifold.point_count; ++i) {
-      if (manifold.points[i].normal_impulse <= 0.0) continue;
-      for (const std::uint32_t index : {manifold.body_a, manifold.body_b}) {
-        bodies_[index].start_linear_velocity = bodies_[index].linear_velocity;
+    bool pushed = false;
+    for (int i = 0; i < manifold.point_count; ++i)
+      pushed |= manifold.points[i].normal_impulse > 0.0;
+    if (!pushed) continue;
+    for (const std::uint32_t index : {manifold.body_a, manifold.body_b}) {
+      std::uint8_t& state = push_state_[index];
+      if (state == 0) {
+        push_normals_[index] = manifold.normal_world;
+        state = 1;
+      } else if (push_normals_[index].cross(manifold.normal_world).norm() > kParallelSine) {
+        state = 2;
       }
+    }
+  }
+  const double impulsive = settings_.solver.collision_velocity_threshold;
+  for (const std::uint32_t index : moving_bodies_) {
+    Body& body = bodies_[index];
+    const Vec3& n = push_normals_[index];
+    const double normal_change = n.dot(body.linear_velocity - body.start_linear_velocity);
+    // The change along the normal is a force's only while the body rests;
+    // one that stops an approach (an inelastic landing) is an impulse at the
+    // start of the step, and the end velocity holds throughout.
+    if (push_state_[index] == 1 && std::abs(normal_change) <= impulsive) {
+      body.start_linear_velocity += n * normal_change;
+      body.start_angular_momentum = body.angular_momentum;
+    } else if (push_state_[index] != 0) {
+      body.start_linear_velocity = body.linear_velocity;
+      body.start_angular_momentum = body.angular_momentum;
     }
   }
 }

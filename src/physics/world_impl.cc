@@ -76,6 +76,7 @@ void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
   body->speeding_up_time = 0.0;
   body->UpdateDerived();
   body->start_linear_velocity = body->linear_velocity;
+  body->start_angular_momentum = body->angular_momentum;
 }
 
 }  // namespace

@@ -70,6 +70,7 @@ class WorldImpl {
   void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
   // Stage 4's parts (step_solver.cc).
   void SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs);
+  void HoldPushedBodies();
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
   void ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt, bool impacts_only);
   void ReportSleepingContacts(double dt);
@@ -118,6 +119,8 @@ class WorldImpl {
   std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
   std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
+  std::vector<Vec3> push_normals_;            // HoldPushedBodies' scratch, per body slot
+  std::vector<std::uint8_t> push_state_;      // 0 not pushed, 1 along one normal, 2 several
   std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
   std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
   std::vector<ContactReport> contacts_;

@@ -46,6 +46,7 @@ struct Body {
   Vec3 force = Vec3::Zero();                    // N, world, accumulated for the next step
   Vec3 torque = Vec3::Zero();                   // N m, world, about the centre of mass
   Vec3 start_linear_velocity = Vec3::Zero();    // m/s, v before this step's forces
+  Vec3 start_angular_momentum = Vec3::Zero();   // kg m^2/s, L before this step's torques
   Vec3 pseudo_linear_velocity = Vec3::Zero();   // m/s, split-impulse correction of this step
   Vec3 pseudo_angular_velocity = Vec3::Zero();  // rad/s
 
