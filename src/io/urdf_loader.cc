@@ -322,8 +322,7 @@ class ModelBuilder {
                                               ": cylinder radius and length must be positive");
         }
         return ShapeWithMass{
-            std::make_shared<const ConvexPolyhedron>(physics::MakeCylinderPolyhedron(
-                cylinder.radius, cylinder.length, options_.cylinder_segments)),
+            physics::Cylinder{cylinder.radius, 0.5 * cylinder.length},
             physics::CylinderMassProperties(density, cylinder.radius, cylinder.length)};
       }
       case urdf::Geometry::MESH: {
@@ -367,10 +366,6 @@ Status ValidateOptions(const UrdfLoadOptions& options) {
   if (!PositiveFinite(options.default_density)) {
     return Status::Error("URDF load option default_density must be positive and finite, got " +
                          FormatNumber(options.default_density));
-  }
-  if (options.cylinder_segments < 3) {
-    return Status::Error("URDF load option cylinder_segments must be at least 3, got " +
-                         std::to_string(options.cylinder_segments));
   }
   if (options.hull.max_vertices < 4) {
     return Status::Error("URDF load option hull.max_vertices must be at least 4, got " +

@@ -26,7 +26,6 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       real_time_factor_(options_.real_time_factor) {
   load_options_.default_density = options_.default_density;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
-  load_options_.cylinder_segments = options_.cylinder_segments;
   load_options_.resolver = ResolveRosUri;
 }
 

@@ -20,7 +20,6 @@ struct UrdfLoadOptions {
   // computed from their collision geometry.
   double default_density = 1000.0;
   HullOptions hull;            // for <mesh> collisions
-  int cylinder_segments = 32;  // count, >= 3: sides of the prism standing in for a <cylinder>
   // Maps package:// and file:// URIs of meshes to local paths. When empty,
   // ResolveFileUri is used, so package:// URIs are an error.
   UriResolver resolver;
