@@ -275,6 +275,28 @@ TEST_F(NodeServicesTest, BodyMarkersShowCollisionGeometryAndFollowDeletes) {
 
 // Bad input: success = false, a message naming the problem, the body count
 // unchanged and the node still answering.
+// A box spawned 5 cm into the ground: the reply names the ground and the
+// depth, and the box is pushed out by positions only, never faster than
+// sqrt(2 g d) + 0.1 m/s, to rest on the ground.
+TEST_F(NodeServicesTest, SpawnIntoOverlapIsReportedAndSeparatesWithoutLaunching) {
+  const auto response =
+      client_.SpawnUrdf("sunk_box", BoxUrdf(1.0, 1.0, 1.0, 1.0), MakePose(20.0, 20.0, 0.45));
+  ASSERT_TRUE(response.success) << response.message;
+  spawned_.push_back("sunk_box");
+  EXPECT_NE(response.message.find("overlaps 'ground' by 0.05 m"), std::string::npos)
+      << response.message;
+  const double limit = std::sqrt(2.0 * 9.81 * 0.05) + 0.1;
+  double fastest = 0.0;
+  for (int step = 0; step < 480; ++step) {
+    ASSERT_TRUE(client_.Step(1).success);
+    const auto state = client_.GetState("sunk_box");
+    const auto& v = state.twist.linear;
+    fastest = std::max(fastest, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+  }
+  EXPECT_LE(fastest, limit);
+  EXPECT_NEAR(client_.GetState("sunk_box").pose.position.z, 0.5, 1e-4);
+}
+
 TEST_F(NodeServicesTest, BadInputIsRefusedAndChangesNothing) {
   SpawnBox("existing", MakePose(0.0, 0.0, 30.0));
   const int frames = FrameCount();

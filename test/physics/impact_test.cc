@@ -134,5 +134,43 @@ TEST(ImpactTest, SmallCubesComeToRestOnAFace) {
   }
 }
 
+// A box spawned 5 cm into the ground and 10 cm into a resting neighbour:
+// FindOverlaps names both with their depths, deepest first, and the step
+// pushes them apart by positions only, so no body ever moves faster than
+// sqrt(2 g d) + 0.1 m/s (what falling through the depth would give, plus
+// a margin), and the box ends at rest on the ground.
+TEST(ImpactTest, SpawnedIntoOverlapSeparatesWithoutLaunching) {
+  World world;
+  const BodyId ground = AddGround(&world, MakeMaterial(0.5, 0.0));
+  BoxSpec neighbour_spec;
+  neighbour_spec.world_from_body = Translation(1.0, 0.0, 0.5);
+  neighbour_spec.material = MakeMaterial(0.5, 0.0);
+  const BodyId neighbour = AddBox(&world, neighbour_spec);
+  BoxSpec spec;
+  spec.world_from_body = Translation(0.1, 0.0, 0.45);
+  spec.material = MakeMaterial(0.5, 0.0);
+  const BodyId box = AddBox(&world, spec);
+  const std::vector<BodyOverlap> overlaps = world.FindOverlaps(box);
+  ASSERT_EQ(overlaps.size(), 2u);
+  EXPECT_EQ(overlaps[0].other, neighbour);
+  EXPECT_NEAR(overlaps[0].depth, 0.1, 1e-9);
+  EXPECT_EQ(overlaps[1].other, ground);
+  EXPECT_NEAR(overlaps[1].depth, 0.05, 1e-9);
+  EXPECT_TRUE(world.FindOverlaps(BodyId{}).empty());
+  const double limit = std::sqrt(2.0 * kG * 0.1) + 0.1;
+  double fastest = 0.0;
+  for (int step = 0; step < 240 * 3; ++step) {
+    world.Step();
+    for (const BodyId id : {box, neighbour}) {
+      fastest = std::max(fastest, world.GetLinearVelocity(id).norm());
+    }
+  }
+  EXPECT_LE(fastest, limit);
+  // What is left is the penetration slop the split impulse leaves alone.
+  const double slop = world.settings().solver.penetration_slop + 1e-9;
+  for (const BodyOverlap& left : world.FindOverlaps(box)) EXPECT_LE(left.depth, slop);
+  EXPECT_NEAR(world.GetPose(box).translation.z(), 0.5, slop);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::physics::testing
