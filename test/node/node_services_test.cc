@@ -294,7 +294,8 @@ TEST_F(NodeServicesTest, SpawnIntoOverlapIsReportedAndSeparatesWithoutLaunching)
     fastest = std::max(fastest, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
   }
   EXPECT_LE(fastest, limit);
-  EXPECT_NEAR(client_.GetState("sunk_box").pose.position.z, 0.5, 1e-4);
+  // At rest, sunk by the penetration slop (1e-4 m) the split impulse leaves.
+  EXPECT_NEAR(client_.GetState("sunk_box").pose.position.z, 0.5, 1e-4 + 1e-9);
 }
 
 TEST_F(NodeServicesTest, BadInputIsRefusedAndChangesNothing) {
