@@ -99,6 +99,53 @@ TEST(ImpactTest, ElasticBoxesReverseWithinTheirImpactStep) {
   }
 }
 
+// With restitution 0, a box (face down) and a ball dropped from 1 m meet the
+// ground at free fall's sqrt(2 g h), at 240 and at 60 Hz: the collision
+// resolved at the time of impact reports that approach speed to 1e-6, no
+// step before it is slowed, and the step of the impact ends at rest.
+TEST(ImpactTest, InelasticLandingIsAtFreeFallSpeed) {
+  const double drop = 1.0;
+  const double landing_speed = std::sqrt(2.0 * kG * drop);
+  for (const double hz : {240.0, 60.0}) {
+    for (const bool ball : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << hz << " Hz, " << (ball ? "ball" : "box"));
+      WorldSettings settings;
+      settings.time_step = 1.0 / hz;
+      World world(settings);
+      AddGround(&world, MakeMaterial(0.5, 0.0));
+      BodyId body;
+      if (ball) {
+        SphereSpec spec;
+        spec.radius = 0.5;
+        spec.world_from_body = Translation(0, 0, 0.5 + drop);
+        spec.material = MakeMaterial(0.5, 0.0);
+        body = AddSphere(&world, spec);
+      } else {
+        BoxSpec spec;
+        spec.world_from_body = Translation(0, 0, 0.5 + drop);
+        spec.material = MakeMaterial(0.5, 0.0);
+        body = AddBox(&world, spec);
+      }
+      const double impact_time = std::sqrt(2.0 * drop / kG);
+      std::vector<ContactReport> collisions;
+      while (world.time() < impact_time - 1e-12) {
+        world.Step();
+        const double vz = world.GetLinearVelocity(body).z();
+        if (world.time() < impact_time) {
+          EXPECT_NEAR(vz, -kG * world.time(), 1e-12 * kG * world.time()) << world.time();
+        } else {
+          EXPECT_NEAR(vz, 0.0, 1e-6) << world.time();
+        }
+        for (const ContactReport& report : world.TakeCollisionLog()) collisions.push_back(report);
+      }
+      ASSERT_FALSE(collisions.empty());
+      for (const ContactReport& collision : collisions) {
+        EXPECT_NEAR(-collision.normal_velocity / landing_speed, 1.0, 1e-6);
+      }
+    }
+  }
+}
+
 // A small body dropped from 3 m with a tumble lands on a corner at 7.7 m/s
 // spinning at hundreds of rad/s. It must come to rest within 3 s on a face
 // (z = half an edge, less the penetration slop), and at no step may its pose
