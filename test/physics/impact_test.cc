@@ -146,6 +146,49 @@ TEST(ImpactTest, InelasticLandingIsAtFreeFallSpeed) {
   }
 }
 
+// A ball fired at 40 m/s along a row of boxes, 2 cm above their tops, into
+// a wall: it never touches the boxes, so no contact with them is ever
+// reported, and every colliding contact reported (with the wall) carries
+// an impulse.
+TEST(ImpactTest, OnlyResolvedCollisionsAreReportedAsColliding) {
+  WorldSettings settings;
+  settings.gravity = Vec3::Zero();
+  World world(settings);
+  AddGround(&world, MakeMaterial(0.5, 0.0));
+  std::vector<BodyId> row;
+  for (int i = 0; i < 10; ++i) {
+    BoxSpec box;
+    box.size = Vec3(0.5, 0.5, 0.5);
+    box.world_from_body = Translation(1.0 + 0.6 * i, 0, 0.25);
+    box.is_static = i % 2 == 0;
+    row.push_back(AddBox(&world, box));
+  }
+  BoxSpec wall;
+  wall.size = Vec3(0.2, 4.0, 4.0);
+  wall.is_static = true;
+  wall.world_from_body = Translation(8.0, 0, 2.0);
+  const BodyId wall_id = AddBox(&world, wall);
+  SphereSpec ball;
+  ball.radius = 0.1;
+  ball.world_from_body = Translation(0, 0, 0.5 + 0.02 + 0.1);
+  ball.linear_velocity = Vec3(40.0, 0, 0);
+  ball.material = MakeMaterial(0.5, 0.5);
+  const BodyId ball_id = AddSphere(&world, ball);
+  int wall_collisions = 0;
+  for (int step = 0; step < 60; ++step) {
+    world.Step();
+    for (const ContactReport& report : world.contacts()) {
+      if (report.type == ContactType::kColliding) EXPECT_GT(report.normal_impulse, 0.0);
+      if (report.body_a != ball_id && report.body_b != ball_id) continue;
+      const BodyId other = report.body_a == ball_id ? report.body_b : report.body_a;
+      EXPECT_TRUE(other == wall_id) << "step " << step;
+      wall_collisions += report.type == ContactType::kColliding;
+    }
+  }
+  EXPECT_GE(wall_collisions, 1);
+  EXPECT_NEAR(world.GetLinearVelocity(ball_id).x(), -20.0, 1e-9);
+}
+
 // A small body dropped from 3 m with a tumble lands on a corner at 7.7 m/s
 // spinning at hundreds of rad/s. It must come to rest within 3 s on a face
 // (z = half an edge, less the penetration slop), and at no step may its pose
