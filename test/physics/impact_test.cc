@@ -178,7 +178,9 @@ TEST(ImpactTest, OnlyResolvedCollisionsAreReportedAsColliding) {
   for (int step = 0; step < 60; ++step) {
     world.Step();
     for (const ContactReport& report : world.contacts()) {
-      if (report.type == ContactType::kColliding) EXPECT_GT(report.normal_impulse, 0.0);
+      if (report.type == ContactType::kColliding) {
+        EXPECT_GT(report.normal_impulse, 0.0);
+      }
       if (report.body_a != ball_id && report.body_b != ball_id) continue;
       const BodyId other = report.body_a == ball_id ? report.body_b : report.body_a;
       EXPECT_TRUE(other == wall_id) << "step " << step;
