@@ -3,6 +3,10 @@
 #include "rigid_body_sim/node/sim_node.h"
 
 #include <cassert>
+#include <cstdint>
+#include <exception>
+#include <string>
+#include <type_traits>
 #include <utility>
 
 #include <rosgraph_msgs/Clock.h>
@@ -27,6 +31,8 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
   load_options_.default_density = options_.default_density;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
   load_options_.cylinder_segments = options_.cylinder_segments;
+  load_options_.max_links = options_.max_links_per_model;
+  load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);
   load_options_.resolver = ResolveRosUri;
 }
 
@@ -44,6 +50,41 @@ std::unique_lock<std::mutex> SimNode::LockWorld() {
   std::unique_lock<std::mutex> lock(mutex_);
   waiting_.fetch_sub(1, std::memory_order_acq_rel);
   return lock;
+}
+
+namespace {
+
+// Whether a service response has the success and message fields.
+template <typename Response, typename = void>
+struct HasSuccess : std::false_type {};
+template <typename Response>
+struct HasSuccess<Response, std::void_t<decltype(std::declval<Response&>().success),
+                                        decltype(std::declval<Response&>().message)>>
+    : std::true_type {};
+
+}  // namespace
+
+template <typename Request, typename Response>
+ros::ServiceServer SimNode::Advertise(const char* name,
+                                      bool (SimNode::*method)(Request& request,
+                                                              Response& response)) {
+  const boost::function<bool(Request&, Response&)> guarded =
+      [this, method, name](Request& request, Response& response) {
+        try {
+          return (this->*method)(request, response);
+        } catch (const std::exception& error) {
+          ROS_ERROR("~%s: %s", name, error.what());
+          response = Response();
+          if constexpr (HasSuccess<Response>::value) {
+            response.success = false;
+            response.message = std::string("internal error: ") + error.what();
+            return true;
+          } else {
+            return false;  // no field to say why: the call fails
+          }
+        }
+      };
+  return private_node_.advertiseService<Request, Response>(name, guarded);
 }
 
 Status SimNode::Start() {
@@ -85,22 +126,17 @@ Status SimNode::Start() {
   }
 
   using Self = SimNode;
-  services_.push_back(private_node_.advertiseService(names::kSpawnService, &Self::OnSpawn, this));
-  services_.push_back(private_node_.advertiseService(names::kDeleteService, &Self::OnDelete, this));
-  services_.push_back(private_node_.advertiseService(names::kResetService, &Self::OnReset, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kSetPausedService, &Self::OnSetPaused, this));
-  services_.push_back(private_node_.advertiseService(names::kStepService, &Self::OnStep, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kGetStateService, &Self::OnGetState, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kSetStateService, &Self::OnSetState, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kApplyWrenchService, &Self::OnApplyWrench, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kGetPhysicsService, &Self::OnGetPhysics, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kSetPhysicsService, &Self::OnSetPhysics, this));
+  services_.push_back(Advertise(names::kSpawnService, &Self::OnSpawn));
+  services_.push_back(Advertise(names::kDeleteService, &Self::OnDelete));
+  services_.push_back(Advertise(names::kResetService, &Self::OnReset));
+  services_.push_back(Advertise(names::kSetPausedService, &Self::OnSetPaused));
+  services_.push_back(Advertise(names::kStepService, &Self::OnStep));
+  services_.push_back(Advertise(names::kCancelStepService, &Self::OnCancelStep));
+  services_.push_back(Advertise(names::kGetStateService, &Self::OnGetState));
+  services_.push_back(Advertise(names::kSetStateService, &Self::OnSetState));
+  services_.push_back(Advertise(names::kApplyWrenchService, &Self::OnApplyWrench));
+  services_.push_back(Advertise(names::kGetPhysicsService, &Self::OnGetPhysics));
+  services_.push_back(Advertise(names::kSetPhysicsService, &Self::OnSetPhysics));
 
   {
     std::lock_guard<std::mutex> lock(mutex_);
