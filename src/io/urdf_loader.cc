@@ -386,6 +386,17 @@ class ModelBuilder {
     const auto key = std::make_tuple(uri, scale.x(), scale.y(), scale.z());
     const auto cached = hulls_.find(key);
     if (cached != hulls_.end()) return cached->second;
+    if (options_.mesh_hull_loader) {
+      const Result<std::string> path = resolver_(uri);
+      if (!path.ok()) {
+        return Result<std::shared_ptr<const ConvexPolyhedron>>::Error("mesh " + Quoted(uri) + ": " +
+                                                                      path.message());
+      }
+      Result<std::shared_ptr<const ConvexPolyhedron>> loaded =
+          options_.mesh_hull_loader(*path, scale, options_.hull);
+      if (loaded.ok()) hulls_.emplace(key, *loaded);
+      return loaded;
+    }
     Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_, options_.max_file_bytes);
     if (!mesh.ok()) return mesh.status();
     Result<ConvexPolyhedron> hull = ComputeConvexHull(mesh->vertices, options_.hull);

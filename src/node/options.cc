@@ -153,6 +153,14 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     return Status::Error("~max_links_per_model " + std::to_string(options.max_links_per_model) +
                          " must be >= 1");
   }
+  if (options.mesh_memory_limit < (1 << 24)) {
+    return Status::Error("~mesh_memory_limit " + std::to_string(options.mesh_memory_limit) +
+                         " bytes is below the allowed 16777216");
+  }
+  if (!(options.mesh_cpu_limit > 0.0 && options.mesh_cpu_limit <= 3600.0)) {
+    return Status::Error("~mesh_cpu_limit " + FormatNumber(options.mesh_cpu_limit) +
+                         " s is outside the allowed range (0, 3600] s");
+  }
   if (options.max_file_bytes < 1) {
     return Status::Error("~max_file_bytes " + std::to_string(options.max_file_bytes) +
                          " must be >= 1");
@@ -279,6 +287,8 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"max_step_count", &options->limits.max_step_count},
       {"max_links_per_model", &options->max_links_per_model},
       {"max_file_bytes", &options->max_file_bytes},
+      {"mesh_memory_limit", &options->mesh_memory_limit},
+      {"mesh_cpu_limit", &options->mesh_cpu_limit},
   };
 }
 

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cstdint>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -12,6 +13,7 @@
 #include <rosgraph_msgs/Clock.h>
 
 #include "node/ros_uri.h"
+#include "rigid_body_sim/io/mesh_process.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 
@@ -20,6 +22,18 @@ namespace rigid_body_sim::node {
 using physics::BodyId;
 using physics::Result;
 using physics::Status;
+
+namespace {
+
+// The mesh helper is built next to the node (devel/lib/rigid_body_sim, or
+// the installed package's lib directory).
+std::string MeshHelperPath() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return (self.parent_path() / "rigid_body_sim_mesh_helper").string();
+}
+
+}  // namespace
 
 SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle private_node)
     : options_(std::move(options)),
@@ -33,6 +47,17 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
   load_options_.cylinder_segments = options_.cylinder_segments;
   load_options_.max_links = options_.max_links_per_model;
   load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);
+  // Meshes are untrusted files: assimp and qhull run in the helper process.
+  io::MeshProcessLimits mesh_limits;
+  mesh_limits.helper_path = MeshHelperPath();
+  mesh_limits.memory_bytes = static_cast<std::uint64_t>(options_.mesh_memory_limit);
+  mesh_limits.cpu_seconds = options_.mesh_cpu_limit;
+  mesh_limits.max_file_bytes = static_cast<std::uint64_t>(options_.max_file_bytes);
+  load_options_.mesh_hull_loader = [mesh_limits](const std::string& path,
+                                                 const physics::Vec3& scale,
+                                                 const io::HullOptions& hull) {
+    return io::CachedMeshHull(path, scale, hull, mesh_limits);
+  };
   load_options_.resolver = ResolveRosUri;
 }
 

@@ -4,6 +4,8 @@
 #define RIGID_BODY_SIM_IO_URDF_LOADER_H_
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,12 @@ inline constexpr double kMinShapeSize = 1e-4;
 inline constexpr double kMaxShapeSize = 1e4;
 inline constexpr double kMaxShapeAspectRatio = 1e3;
 
+// Builds the hull of the mesh file at a resolved local `path`, scaled per
+// axis; e.g. CachedMeshHull (mesh_process.h), out of process.
+using MeshHullLoader =
+    std::function<physics::Result<std::shared_ptr<const physics::ConvexPolyhedron>>(
+        const std::string& path, const physics::Vec3& scale, const HullOptions& hull)>;
+
 struct UrdfLoadOptions {
   // kg/m^3: density of links without <inertial>, whose mass properties are
   // computed from their collision geometry.
@@ -34,6 +42,9 @@ struct UrdfLoadOptions {
   // Bytes; a URDF or mesh file larger than this, or not a regular file
   // (/dev/zero, a FIFO), is refused before it is read.
   std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;
+  // When set, mesh hulls come from it; when empty, meshes are imported and
+  // hulled in this process (LoadMesh, ComputeConvexHull).
+  MeshHullLoader mesh_hull_loader;
   // Maps package:// and file:// URIs of meshes to local paths. When empty,
   // ResolveFileUri is used, so package:// URIs are an error.
   UriResolver resolver;

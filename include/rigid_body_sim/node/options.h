@@ -54,6 +54,9 @@ struct NodeOptions {
   RequestLimits limits;
   int max_links_per_model = 1000;  // ~max_links_per_model: count, >= 1
   int max_file_bytes = 256 << 20;  // ~max_file_bytes: URDF and mesh files, bytes, >= 1
+  // Limits of the mesh helper process (io/mesh_process.h).
+  int mesh_memory_limit = 1 << 30;  // ~mesh_memory_limit: bytes of address space, >= 2^24
+  double mesh_cpu_limit = 10.0;     // ~mesh_cpu_limit: s of CPU, (0, 3600]
   // ~models: spawned at start-up, in order; each entry has the fields of
   // Spawn (name, urdf, urdf_path, is_static, friction, restitution), pose:
   // [x, y, z, roll, pitch, yaw] (m, rad; default all 0) and twist:
