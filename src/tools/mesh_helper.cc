@@ -34,8 +34,14 @@ bool LimitSelf(rlim_t memory_bytes, double cpu_seconds) {
   const rlimit memory{memory_bytes, memory_bytes};
   const rlimit cpu_limit{cpu, cpu + 1};
   const rlimit none{0, 0};
-  return setrlimit(RLIMIT_AS, &memory) == 0 && setrlimit(RLIMIT_CPU, &cpu_limit) == 0 &&
-         setrlimit(RLIMIT_CORE, &none) == 0;
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer has reserved terabytes of address space for its
+  // shadow before main: an address-space limit would fail every allocation.
+  (void)memory;
+#else
+  if (setrlimit(RLIMIT_AS, &memory) != 0) return false;
+#endif
+  return setrlimit(RLIMIT_CPU, &cpu_limit) == 0 && setrlimit(RLIMIT_CORE, &none) == 0;
 }
 
 }  // namespace
