@@ -106,7 +106,7 @@ fuzz: deps
 	  -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \
 	  -DCMAKE_CXX_FLAGS="-O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" \
 	  > /dev/null
-	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target $(FUZZERS)
+	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target $(FUZZERS) rigid_body_sim_mesh_helper
 	@mkdir -p $(FUZZ_BUILD)/artifacts
 	@for fuzzer in $(FUZZERS); do \
 	  name=$${fuzzer%_fuzzer}; rm -rf $(FUZZ_BUILD)/corpus/$$name; mkdir -p $(FUZZ_BUILD)/corpus/$$name; \

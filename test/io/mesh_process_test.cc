@@ -107,6 +107,22 @@ TEST(MeshProcessTest, StuckHelperIsKilledAtTheDeadline) {
   EXPECT_LT(waited, 5.0);
 }
 
+// An ASCII PLY whose header the fuzzer corrupted (mesh_parser_fuzzer found
+// it in its first minute): assimp's PLY reader loops on it forever. The
+// helper's CPU limit of 1 s ends it; the caller gets a message.
+TEST(MeshProcessTest, ImporterLoopingForeverIsStoppedByTheCpuLimit) {
+  MeshProcessLimits limits = HelperLimits();
+  limits.cpu_seconds = 1.0;
+  const auto start = std::chrono::steady_clock::now();
+  const Result<ConvexPolyhedron> hull =
+      LoadMeshHullOutOfProcess(kDataDir + "/hang_header.ply", Vec3::Ones(), HullOptions(), limits);
+  const double waited =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(hull.ok());
+  EXPECT_NE(hull.message().find("ran out of CPU time"), std::string::npos) << hull.message();
+  EXPECT_LT(waited, 3.5);  // the wall-time deadline is 2 x 1 + 1 s
+}
+
 // 16 MiB of address space is less than the helper has mapped at start, so
 // the importer's allocations fail: an error naming the limit (assimp may
 // take its failed allocation for a malformed file), not a dead caller.
