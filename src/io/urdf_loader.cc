@@ -151,7 +151,12 @@ class ModelBuilder {
   ModelBuilder(const UrdfLoadOptions& options, UriResolver resolver)
       : options_(options), resolver_(std::move(resolver)) {}
 
-  Result<LoadedModel> Build(const std::string& xml) {
+  Result<LoadedModel> Build(const std::string& unpadded_xml) {
+    // TinyXML (ours and urdfdom's) steps over a UTF-8 sequence by the length
+    // its lead byte announces without looking for the end of the text, so a
+    // document ending in a lead byte was read past its end (found by
+    // urdf_loader_fuzzer). Trailing NULs keep those reads inside the string.
+    const std::string xml = unpadded_xml + std::string(4, '\0');
     TiXmlDocument document;
     document.Parse(xml.c_str());
     if (document.Error()) {
