@@ -153,10 +153,11 @@ class ModelBuilder {
 
   Result<LoadedModel> Build(const std::string& unpadded_xml) {
     // TinyXML (ours and urdfdom's) steps over a UTF-8 sequence by the length
-    // its lead byte announces without looking for the end of the text, so a
-    // document ending in a lead byte was read past its end (found by
-    // urdf_loader_fuzzer). Trailing NULs keep those reads inside the string.
-    const std::string xml = unpadded_xml + std::string(4, '\0');
+    // its lead byte announces (at most 4) without looking for the end of the
+    // text: urdf_loader_fuzzer caught it reading 12 bytes past the end of a
+    // document ending in such a byte. Trailing NULs keep those reads inside
+    // the string, and end the name or value being read.
+    const std::string xml = unpadded_xml + std::string(16, '\0');
     TiXmlDocument document;
     document.Parse(xml.c_str());
     if (document.Error()) {
