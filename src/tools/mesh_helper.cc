@@ -17,6 +17,16 @@
 #include "rigid_body_sim/io/mesh_loader.h"
 #include "rigid_body_sim/io/mesh_process.h"
 
+// GCC defines __SANITIZE_ADDRESS__; clang answers __has_feature.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define RBS_HAS_ADDRESS_SANITIZER 1
+#endif
+#endif
+#ifndef RBS_HAS_ADDRESS_SANITIZER
+#define RBS_HAS_ADDRESS_SANITIZER 0
+#endif
+
 namespace {
 
 using rigid_body_sim::physics::Result;
@@ -34,7 +44,7 @@ bool LimitSelf(rlim_t memory_bytes, double cpu_seconds) {
   const rlimit memory{memory_bytes, memory_bytes};
   const rlimit cpu_limit{cpu, cpu + 1};
   const rlimit none{0, 0};
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || RBS_HAS_ADDRESS_SANITIZER
   // AddressSanitizer has reserved terabytes of address space for its
   // shadow before main: an address-space limit would fail every allocation.
   (void)memory;
