@@ -28,6 +28,12 @@ struct Reader {
     }
     return value;
   }
+  std::uint64_t NextCount() {
+    double bits = Next();
+    std::uint64_t count = 0;
+    std::memcpy(&count, &bits, sizeof(count));
+    return count;
+  }
   Vec3 NextVec() {
     const double x = Next();
     const double y = Next();
@@ -90,7 +96,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!world.SetSettings(settings).ok()) std::abort();
     }
   }
-  (void)node::ValidateStepCount(static_cast<std::uint64_t>(in.Next()), limits);
+  (void)node::ValidateStepCount(in.NextCount(), limits);
   (void)node::ValidateRealTimeFactor(in.Next(), "real_time_factor");
   for (int i = 0; i < 3; ++i) {
     world.Step();
