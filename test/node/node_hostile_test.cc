@@ -24,6 +24,9 @@ namespace {
 
 constexpr double kTimeout = 20.0;  // s of wall time for any single wait
 constexpr double kG = 9.81;
+// Spinning boxes that keep a 100,000-step ~step busy for a second or more
+// on an idle machine; the test cancels it at 40 % at the latest.
+constexpr int kSpinners = 400;
 
 std::string OneLink(const std::string& geometry) {
   return "<robot name='r'><link name='base_link'><collision><geometry>" + geometry +
@@ -59,7 +62,8 @@ class NodeHostileTest : public ::testing::Test {
     client_.Delete("anchor");
     client_.Delete("neighbour");
     client_.Delete("light");
-    for (int i = 0; i < 40; ++i) client_.Delete("spinner" + std::to_string(i));
+    SimClient deleter(/*persistent=*/true);
+    for (int i = 0; i < kSpinners; ++i) deleter.Delete("spinner" + std::to_string(i));
     client_.SetPaused(false);
   }
 
@@ -189,22 +193,26 @@ TEST_F(NodeHostileTest, HostileStateWrenchAndPhysicsAreRefusedByField) {
   EXPECT_NEAR(stepped.sim_time, before_.sim_time + before_.physics.time_step, 1e-12);
 }
 
-// 40 boxes spinning in free space (no gravity) stay awake, so 100,000 steps
-// take seconds. Meanwhile ~get_state answers within 50 ms (p99), ~states
+// kSpinners boxes spinning in free space (no gravity) stay awake, so
+// 100,000 steps take seconds. Meanwhile ~get_state answers within 50 ms (p99), ~states
 // keeps coming, and ~cancel_step stops the call, which says how many steps
 // ran; sim time moved by exactly that many steps.
 TEST_F(NodeHostileTest, LongStepLetsOthersInAndIsCancelled) {
   ASSERT_TRUE(SetPhysics(1.0 / 240.0, 1.0, 0.0).success);
-  for (int i = 0; i < 40; ++i) {
+  // One connection for hundreds of calls: roscpp's per-call connections
+  // fail now and then in a tight loop (sim_client.h).
+  SimClient spawner(/*persistent=*/true);
+  for (int i = 0; i < kSpinners; ++i) {
     rigid_body_sim::Spawn::Request spinner;
     spinner.name = "spinner" + std::to_string(i);
     spinner.urdf = BoxUrdf(0.2, 0.4, 0.6, 1.0);
-    spinner.pose = MakePose(3.0 * (i % 8), 3.0 * (i / 8), 10);
-    spinner.twist.angular.x = 1.0 + 0.1 * i;
+    spinner.pose = MakePose(3.0 * (i % 20), 3.0 * (i / 20), 10);
+    spinner.twist.angular.x = 1.0 + 0.005 * i;
     spinner.twist.angular.y = 2.0;
     spinner.friction = -1;
     spinner.restitution = -1;
-    ASSERT_TRUE(client_.Spawn(spinner).success);
+    const auto spawned = spawner.Spawn(spinner);
+    ASSERT_TRUE(spawned.success) << spawned.message;
   }
   const double start_time = client_.Step(0).sim_time;
   Latest<rigid_body_sim::ModelStates> states(node_, "states");
@@ -215,8 +223,16 @@ TEST_F(NodeHostileTest, LongStepLetsOthersInAndIsCancelled) {
   ASSERT_TRUE(WaitFor([&] { return states.Next(1.0).has_value(); }, kTimeout));
   const std::uint64_t states_before = states.count();
   std::vector<double> latencies;
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(1.0);
-  while (ros::WallTime::now() < end) {
+  // Watched for 0.5 s, or until ~states shows 40 % of the steps done, so
+  // that the call is still running when it is cancelled however fast the
+  // machine.
+  const double cancel_at = start_time + 0.4 * 100000 / 240.0;
+  const auto sim_time = [&] {
+    const auto message = states.Get();
+    return message ? message->header.stamp.toSec() : start_time;
+  };
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(0.5);
+  while (ros::WallTime::now() < end && sim_time() < cancel_at) {
     const ros::WallTime sent = ros::WallTime::now();
     ASSERT_TRUE(client_.GetState("spinner0").success);
     latencies.push_back((ros::WallTime::now() - sent).toSec());
@@ -229,6 +245,7 @@ TEST_F(NodeHostileTest, LongStepLetsOthersInAndIsCancelled) {
   EXPECT_FALSE(reply.success);
   EXPECT_NE(reply.message.find("stopped by ~cancel_step after "), std::string::npos)
       << reply.message;
+  ASSERT_NE(reply.message.find("after "), std::string::npos) << reply.message;
   const std::string count_text = reply.message.substr(reply.message.find("after ") + 6);
   const long steps_run = std::stol(count_text);
   EXPECT_GT(steps_run, 0);
@@ -238,16 +255,16 @@ TEST_F(NodeHostileTest, LongStepLetsOthersInAndIsCancelled) {
   EXPECT_FALSE(client_.CancelStep().success);  // nothing left to cancel
 
   std::sort(latencies.begin(), latencies.end());
-  ASSERT_GE(latencies.size(), 20u);
+  ASSERT_GE(latencies.size(), 10u);
   const double p99 = latencies[static_cast<std::size_t>(0.99 * (latencies.size() - 1))];
   EXPECT_LT(p99, 0.050) << latencies.size() << " calls";
   std::printf(
       "[measured] ~get_state during a 100,000-step ~step: p99 %.2f ms, max %.2f ms over "
-      "%zu calls; %llu ~states in 1 s; cancelled after %ld steps\n",
+      "%zu calls; %llu ~states meanwhile; cancelled after %ld steps\n",
       1e3 * p99, 1e3 * latencies.back(), latencies.size(),
       static_cast<unsigned long long>(states_during), steps_run);
-  // ~publish_rate is 50 Hz: over the 1 s at least a handful of messages.
-  EXPECT_GE(states_during, 10u);
+  // ~publish_rate is 50 Hz: messages keep coming while the call runs.
+  EXPECT_GE(states_during, 3u);
   ASSERT_TRUE(SetPhysics(1.0 / 240.0, 1.0, -kG).success);
 }
 
