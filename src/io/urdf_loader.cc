@@ -357,11 +357,8 @@ class ModelBuilder {
             !status.ok()) {
           return status;
         }
-        Result<ConvexPolyhedron> prism = physics::TryMakeCylinderPolyhedron(
-            cylinder.radius, cylinder.length, options_.cylinder_segments);
-        if (!prism.ok()) return Result<ShapeWithMass>::Error(where + ": " + prism.message());
         return ShapeWithMass{
-            std::make_shared<const ConvexPolyhedron>(std::move(prism).value()),
+            physics::Cylinder{cylinder.radius, 0.5 * cylinder.length},
             physics::CylinderMassProperties(density, cylinder.radius, cylinder.length)};
       }
       case urdf::Geometry::MESH: {
@@ -426,10 +423,6 @@ Status ValidateOptions(const UrdfLoadOptions& options) {
   if (!PositiveFinite(options.default_density)) {
     return Status::Error("URDF load option default_density must be positive and finite, got " +
                          FormatNumber(options.default_density));
-  }
-  if (options.cylinder_segments < 3) {
-    return Status::Error("URDF load option cylinder_segments must be at least 3, got " +
-                         std::to_string(options.cylinder_segments));
   }
   if (options.max_links < 1) {
     return Status::Error("URDF load option max_links must be at least 1, got " +

@@ -200,6 +200,10 @@ std::vector<visualization_msgs::Marker> ShapeMarkers(const std::vector<physics::
     if (const auto* sphere = std::get_if<physics::Sphere>(&shape.geometry)) {
       marker.type = visualization_msgs::Marker::SPHERE;
       marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * sphere->radius;
+    } else if (const auto* cylinder = std::get_if<physics::Cylinder>(&shape.geometry)) {
+      marker.type = visualization_msgs::Marker::CYLINDER;
+      marker.scale.x = marker.scale.y = 2.0 * cylinder->radius;
+      marker.scale.z = 2.0 * cylinder->half_length;
     } else if (const auto* hull =
                    std::get_if<std::shared_ptr<const physics::ConvexPolyhedron>>(&shape.geometry)) {
       marker.type = visualization_msgs::Marker::TRIANGLE_LIST;

@@ -200,10 +200,6 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     return Status::Error("~max_hull_vertices " + std::to_string(options.max_hull_vertices) +
                          " must be >= 4");
   }
-  if (options.cylinder_segments < 3) {
-    return Status::Error("~cylinder_segments " + std::to_string(options.cylinder_segments) +
-                         " must be >= 3");
-  }
   if (!(options.status_period > 0.0) || !std::isfinite(options.status_period)) {
     return Status::Error("~status_period " + FormatNumber(options.status_period) +
                          " s must be positive");
@@ -257,7 +253,6 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"default_restitution", &options->defaults.restitution},
       {"default_density", &options->default_density},
       {"max_hull_vertices", &options->max_hull_vertices},
-      {"cylinder_segments", &options->cylinder_segments},
       {"contact_margin", &world.contact_margin},
       {"contact_reuse_distance", &world.contact_reuse_distance},
       {"continuous_fraction", &world.continuous_fraction},

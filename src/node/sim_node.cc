@@ -44,7 +44,6 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       real_time_factor_(options_.real_time_factor) {
   load_options_.default_density = options_.default_density;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
-  load_options_.cylinder_segments = options_.cylinder_segments;
   load_options_.max_links = options_.max_links_per_model;
   load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);
   // Meshes are untrusted files: assimp and qhull run in the helper process.

@@ -44,9 +44,28 @@ bool SimNode::OnSpawn(rigid_body_sim::Spawn::Request& request,
                 names::kSpawnService);
   }
   response.success = true;
-  response.message = "spawned '" + request.name + "'";
+  response.message = "spawned '" + request.name + "'" + DescribeOverlaps(request.name);
   response.frames = *frames;
   return true;
+}
+
+// "; overlaps 'crate' by 0.1 m, 'ground' by 0.05 m" for what the model
+// was spawned into, deepest first; the step pushes them apart by positions
+// only, so nothing is launched.
+std::string SimNode::DescribeOverlaps(const std::string& model_name) {
+  std::unique_lock<std::mutex> lock = LockWorld();
+  const Model* model = registry_.Find(model_name);
+  if (model == nullptr) return "";
+  std::string text;
+  for (const physics::BodyOverlap& overlap : world_.FindOverlaps(model->body)) {
+    const Model* other = registry_.FindByBody(overlap.other);
+    const std::string name = other != nullptr ? other->name : names::kGroundName;
+    text += (text.empty() ? "; overlaps '" : ", '") + name + "' by " + FormatNumber(overlap.depth) +
+            " m";
+  }
+  if (!text.empty())
+    ROS_WARN("model '%s' spawned into an overlap%s", model_name.c_str(), text.c_str());
+  return text;
 }
 
 bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,

@@ -41,12 +41,8 @@ void ContactSolver::Prepare() {
       point.normal_velocity_before = NormalVelocity(manifold, point);
       const double epsilon = settings_.collision_velocity_threshold;
       if (point.separation > settings_.contact_tolerance) {
-        // Apart now, but an inelastic point (a speculative row) whose
-        // approach closes the gap within the step collides in this step.
-        // It is reported as a collision only if its row takes an impulse.
-        const bool meets = manifold.restitution <= 0.0 && point.normal_velocity_before < -epsilon &&
-                           -point.normal_velocity_before * time_step_ >= point.separation;
-        point.type = meets ? ContactType::kColliding : ContactType::kSeparating;
+        // Apart: the time-of-impact search finds when it touches.
+        point.type = ContactType::kSeparating;
       } else if (point.normal_velocity_before < -epsilon) {
         point.type = ContactType::kColliding;
       } else if (point.normal_velocity_before <= epsilon) {

@@ -158,11 +158,9 @@ class ContactSolver {
   // drift x += dt/2 (v_start + v_end) from entering the other body,
   // target = min(0, -2 max(separation, 0)/dt - v_r,start), so a body that
   // leaves the surface within the step flies free, and one held at rest is
-  // not pushed out (that is the split impulse's job). Points of inelastic
-  // pairs that are still apart join as speculative rows with target
-  // min(0, -separation/dt): the gap may close within the step, not more.
-  // Then the split-impulse pseudo velocities that push penetrating contacts
-  // apart. Each island of the contact graph stops sweeping on its own
+  // not pushed out (that is the split impulse's job). Points still apart are
+  // left to the time-of-impact search. Then the split-impulse pseudo velocities that push
+  // penetrating contacts apart. Each island of the contact graph stops sweeping on its own
   // (FindIslands); a small one still unconverged is finished by pivoting
   // (FinishIslandsExactly).
   void SolveRestingContacts();

@@ -15,11 +15,13 @@ namespace {
 
 using PolyhedronPtr = std::shared_ptr<const ConvexPolyhedron>;
 
-// Variant order (Sphere, polyhedron, HalfSpace) is the dispatch order: the
+// Variant order (Sphere, polyhedron, HalfSpace, Cylinder) is the dispatch order: the
 // pair is swapped so that A has the lower index, and the result swapped back.
 constexpr std::size_t kSphereIndex = 0;
 constexpr std::size_t kPolyhedronIndex = 1;
 constexpr std::size_t kHalfSpaceIndex = 2;
+constexpr std::size_t kCylinderIndex = 3;
+constexpr std::size_t kShapeKinds = 4;
 
 // A single-point manifold.
 bool SinglePoint(const Vec3& normal_world, const Vec3& position_world, double separation,
@@ -192,31 +194,53 @@ bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManif
   const Pose& world_from_b = swapped ? input.world_from_a : input.world_from_b;
   const double contact_distance = input.contact_distance;
 
+  // The cylinder routines take the cylinder as A; with the dispatch order
+  // it arrives as B, so those pairs swap once more.
   bool touching = false;
-  switch (a.index() * 3 + b.index()) {
-    case kSphereIndex * 3 + kSphereIndex:
+  bool cylinder_swapped = false;
+  const Cylinder* cylinder_b = std::get_if<Cylinder>(&b);
+  const CylinderPair cylinder_pair{cylinder_b, world_from_b, world_from_a, contact_distance};
+  switch (a.index() * kShapeKinds + b.index()) {
+    case kSphereIndex* kShapeKinds + kSphereIndex:
       touching = CollideSpheres(std::get<Sphere>(a), world_from_a.translation, std::get<Sphere>(b),
                                 world_from_b.translation, contact_distance, manifold);
       break;
-    case kSphereIndex * 3 + kPolyhedronIndex:
+    case kSphereIndex* kShapeKinds + kPolyhedronIndex:
       touching = CollideSpherePolyhedron(std::get<Sphere>(a), world_from_a.translation,
                                          *std::get<PolyhedronPtr>(b), world_from_b,
                                          contact_distance, manifold);
       break;
-    case kSphereIndex * 3 + kHalfSpaceIndex:
+    case kSphereIndex* kShapeKinds + kHalfSpaceIndex:
       touching = CollideSphereHalfSpace(std::get<Sphere>(a), world_from_a.translation, world_from_b,
                                         contact_distance, manifold);
       break;
-    case kPolyhedronIndex * 3 + kPolyhedronIndex:
+    case kPolyhedronIndex* kShapeKinds + kPolyhedronIndex:
       // Never swapped, so the witness keeps the caller's A/B roles.
       touching =
           CollidePolyhedra({std::get<PolyhedronPtr>(a).get(), world_from_a,
                             std::get<PolyhedronPtr>(b).get(), world_from_b, contact_distance},
                            witness, manifold, stats);
       break;
-    case kPolyhedronIndex * 3 + kHalfSpaceIndex:
+    case kPolyhedronIndex* kShapeKinds + kHalfSpaceIndex:
       touching = CollidePolyhedronHalfSpace(*std::get<PolyhedronPtr>(a), world_from_a, world_from_b,
                                             contact_distance, manifold);
+      break;
+    case kSphereIndex* kShapeKinds + kCylinderIndex:
+      touching = CollideCylinderSphere(cylinder_pair, std::get<Sphere>(a), manifold);
+      cylinder_swapped = true;
+      break;
+    case kPolyhedronIndex* kShapeKinds + kCylinderIndex:
+      touching = CollideCylinderPolyhedron(cylinder_pair, *std::get<PolyhedronPtr>(a), manifold);
+      cylinder_swapped = true;
+      break;
+    case kHalfSpaceIndex* kShapeKinds + kCylinderIndex:
+      touching = CollideCylinderHalfSpace(cylinder_pair, manifold);
+      cylinder_swapped = true;
+      break;
+    case kCylinderIndex* kShapeKinds + kCylinderIndex:
+      touching =
+          CollideCylinders({&std::get<Cylinder>(a), world_from_a, world_from_b, contact_distance},
+                           *cylinder_b, manifold);
       break;
     default:
       assert(false && "two half-spaces are both static and never collide");
@@ -226,7 +250,7 @@ bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManif
     manifold->point_count = 0;
     return false;
   }
-  if (swapped) SwapRoles(manifold);
+  if (swapped != cylinder_swapped) SwapRoles(manifold);
   return true;
 }
 

@@ -3,6 +3,7 @@
 #define RIGID_BODY_SIM_PHYSICS_NARROW_PHASE_H_
 
 #include "physics/contact_manifold.h"
+#include "physics/cylinder_collision.h"
 #include "physics/polyhedron_collision.h"
 #include "rigid_body_sim/physics/shape.h"
 #include "rigid_body_sim/physics/types.h"

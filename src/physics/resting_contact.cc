@@ -40,9 +40,8 @@ void ContactSolver::SolveRestingContacts() {
   }
 }
 
-// Rows of the resting solve: the touching points, and the speculative ones
-// of inelastic pairs, copied into one array in manifold order so that a
-// sweep walks memory once.
+// Rows of the resting solve: the touching points, copied into one array in
+// manifold order so that a sweep walks memory once.
 void ContactSolver::BuildRestingRows() {
   const double inverse_dt = 1.0 / time_step_;
   rows_.clear();
@@ -53,13 +52,9 @@ void ContactSolver::BuildRestingRows() {
       SolverPoint& point = manifold.points[i];
       // A point that is not touching yet is left to the time-of-impact
       // search, so that its collision keeps its approach speed and
-      // restitution, unless the manifold has none to keep (e = 0): then it
-      // is a speculative row that lets the gap close within the step but
-      // not overshoot, so a face landing on a face is held at all its
-      // corners at once instead of tipping about the first one to touch,
-      // and a column pushed from above is held at its near gaps too.
-      const bool touching = point.separation <= settings_.contact_tolerance;
-      if (!touching && manifold.restitution > 0.0) {
+      // restitution, e = 0 included: an inelastic box lands at the speed of
+      // free fall, and the rest of its step is simulated after the impact.
+      if (point.separation > settings_.contact_tolerance) {
         point.normal_impulse = 0.0;
         point.tangent_impulse = {0.0, 0.0};
         continue;
@@ -96,14 +91,9 @@ void ContactSolver::BuildRestingRows() {
         row.normal_coupling[k] = point.r_a.cross(row.tangent[k]).dot(row.angular_a[0]) +
                                  point.r_b.cross(row.tangent[k]).dot(row.angular_b[0]);
       }
-      // A touching point: the trapezoidal drift dt/2 (v_start + v_end) must
-      // not close the gap. A speculative point: a body its row pushes drifts
-      // dt v_end (step_solver.cc), which must close the gap exactly at most;
-      // one it does not push and that still overshoots was apart at the
-      // start, so the time-of-impact search backs it up.
+      // The trapezoidal drift dt/2 (v_start + v_end) must not close the gap.
       const double gap = std::max(point.separation, 0.0);
-      row.target = std::min(0.0, touching ? -2.0 * gap * inverse_dt - point.normal_velocity_start
-                                          : -gap * inverse_dt);
+      row.target = std::min(0.0, -2.0 * gap * inverse_dt - point.normal_velocity_start);
       row.depth = -point.separation - settings_.penetration_slop;
       row.normal_impulse = point.normal_impulse;
       row.tangent_impulse = point.tangent_impulse;

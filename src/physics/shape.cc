@@ -30,6 +30,15 @@ Status ValidateGeometry(const ShapeGeometry& geometry) {
                                  " vertices, needs at least 4");
           }
           return Status::Ok();
+        } else if constexpr (std::is_same_v<T, Cylinder>) {
+          if (!std::isfinite(shape.radius) || shape.radius <= 0.0 ||
+              !std::isfinite(shape.half_length) || shape.half_length <= 0.0) {
+            std::ostringstream out;
+            out << "cylinder radius and half length must be positive and finite, got "
+                << shape.radius << " m and " << shape.half_length << " m";
+            return Status::Error(out.str());
+          }
+          return Status::Ok();
         } else {
           static_assert(std::is_same_v<T, HalfSpace>, "unhandled shape geometry");
           return Status::Ok();

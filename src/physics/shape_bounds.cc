@@ -45,6 +45,16 @@ Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape) {
     const Vec3 radius = Vec3::Constant(sphere->radius);
     return Aabb{world_from_shape.translation - radius, world_from_shape.translation + radius};
   }
+  if (const auto* cylinder = std::get_if<Cylinder>(&geometry)) {
+    // Along world axis e_i the cylinder reaches h |a_i| + r sqrt(1 - a_i^2).
+    const Vec3 axis = world_from_shape.rotation * Vec3::UnitZ();
+    Vec3 extent;
+    for (int i = 0; i < 3; ++i) {
+      extent[i] = cylinder->half_length * std::abs(axis[i]) +
+                  cylinder->radius * std::sqrt(std::max(0.0, 1.0 - axis[i] * axis[i]));
+    }
+    return Aabb{world_from_shape.translation - extent, world_from_shape.translation + extent};
+  }
   const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
   assert(polyhedron != nullptr && *polyhedron != nullptr);
   return PolyhedronAabb(**polyhedron, world_from_shape);
@@ -52,6 +62,9 @@ Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape) {
 
 double ShapeThickness(const ShapeGeometry& geometry) {
   if (const auto* sphere = std::get_if<Sphere>(&geometry)) return 2.0 * sphere->radius;
+  if (const auto* cylinder = std::get_if<Cylinder>(&geometry)) {
+    return 2.0 * std::min(cylinder->radius, cylinder->half_length);
+  }
   const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
   if (polyhedron == nullptr) return std::numeric_limits<double>::infinity();
   double thickness = std::numeric_limits<double>::infinity();
@@ -65,6 +78,9 @@ double ShapeThickness(const ShapeGeometry& geometry) {
 double ShapeBoundingRadius(const ShapeGeometry& geometry, const Vec3& center_shape) {
   if (const auto* sphere = std::get_if<Sphere>(&geometry)) {
     return center_shape.norm() + sphere->radius;
+  }
+  if (const auto* cylinder = std::get_if<Cylinder>(&geometry)) {
+    return center_shape.norm() + std::hypot(cylinder->radius, cylinder->half_length);
   }
   const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
   if (polyhedron == nullptr) return std::numeric_limits<double>::infinity();

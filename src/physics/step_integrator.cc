@@ -196,7 +196,10 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* appr
   constexpr double kNoImpact = std::numeric_limits<double>::infinity();
   *approach_speed = 0.0;
   double touching = settings_.solver.contact_tolerance;
-  double target_gap = 0.5 * touching;
+  // The search stops within 5 % of the touching band above the surface, so
+  // the speed at the impact is free fall's to g (0.05 epsilon) / v^2:
+  // 2.6e-7 of it after a 1 m drop.
+  double target_gap = 0.05 * touching;
   const BodyPath& path_a = paths_[pair->body_a];
   const BodyPath& path_b = paths_[pair->body_b];
   // The gap at the start: the nearest point of the manifold, or, with no

@@ -16,6 +16,11 @@ namespace {
 // entry, start loading: each load takes about as long as a few visits.
 constexpr std::size_t kSlotPrefetchAhead = 16;
 constexpr std::size_t kEntryPrefetchAhead = 8;
+// A pair's contact margin is at most this fraction of its thinner body's
+// thickness: with a 5 mm margin a 5 mm cube would be all within it, and the
+// reduction to four points could keep its top corners and drop the bottom
+// ones about to touch, which then sink into the ground unseen.
+constexpr double kMarginPerThickness = 0.25;
 
 // Puts the moving body of a pair first when only one moves, so that normals
 // point from the static or sleeping body B into A (CollideBodies).
@@ -69,7 +74,9 @@ double WorldImpl::ContactDistance(const Body& a, const Body& b, double dt) const
   const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
                                a.angular_velocity.norm() * a.bounding_radius +
                                b.angular_velocity.norm() * b.bounding_radius;
-  return settings_.contact_margin + dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
+  const double margin =
+      std::min(settings_.contact_margin, kMarginPerThickness * std::min(a.thickness, b.thickness));
+  return margin + dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
 }
 
 // A face-defined manifold between polyhedra carried to the current poses

@@ -36,6 +36,7 @@ Status World::ApplyTorque(BodyId id, const Vec3& torque_world) {
 }
 
 void World::Step() { impl_->Step(); }
+std::vector<BodyOverlap> World::FindOverlaps(BodyId id) const { return impl_->FindOverlaps(id); }
 double World::time() const { return impl_->time(); }
 const StepProfile& World::last_step_profile() const { return impl_->last_step_profile(); }
 void World::Restart() { impl_->Restart(); }

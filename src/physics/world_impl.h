@@ -50,6 +50,7 @@ class WorldImpl {
   Status ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Vec3& point_world);
   Status ApplyTorque(BodyId id, const Vec3& torque_world);
   void Step();
+  std::vector<BodyOverlap> FindOverlaps(BodyId id) const;  // world_queries.cc
   double time() const { return time_; }
   const StepProfile& last_step_profile() const { return last_step_profile_; }
   void Restart();

@@ -134,10 +134,13 @@ TEST(UrdfLoaderTest, CompoundModelWithFixedJointMergesIntoOneBody) {
       EXPECT_DOUBLE_EQ(model->shapes[i].shape.material.friction, 0.9);
     }
   }
-  // Box: 8 vertices; cylinder: a 32-gon prism; sphere exact; meshes: hulls
-  // of the chamfered box, the DAE one scaled by 2.
+  // Box: 8 vertices; cylinder and sphere exact; meshes: hulls of the
+  // chamfered box, the DAE one scaled by 2.
   EXPECT_EQ(PolyhedronOf(model->shapes[0]).vertices.size(), 8u);
-  EXPECT_EQ(PolyhedronOf(model->shapes[1]).vertices.size(), 64u);
+  const auto* cylinder = std::get_if<physics::Cylinder>(&model->shapes[1].shape.geometry);
+  ASSERT_NE(cylinder, nullptr);
+  EXPECT_DOUBLE_EQ(cylinder->radius, 0.1);
+  EXPECT_DOUBLE_EQ(cylinder->half_length, 0.1);  // half of length 0.2
   ASSERT_TRUE(std::holds_alternative<physics::Sphere>(model->shapes[2].shape.geometry));
   EXPECT_DOUBLE_EQ(std::get<physics::Sphere>(model->shapes[2].shape.geometry).radius, 0.05);
   const ConvexPolyhedron& stl_hull = PolyhedronOf(model->shapes[3]);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
@@ -275,6 +276,71 @@ TEST_F(NodeServicesTest, BodyMarkersShowCollisionGeometryAndFollowDeletes) {
 
 // Bad input: success = false, a message naming the problem, the body count
 // unchanged and the node still answering.
+// A box spawned 5 cm into the ground: the reply names the ground and the
+// depth, and the box is pushed out by positions only, never faster than
+// sqrt(2 g d) + 0.1 m/s, to rest on the ground.
+TEST_F(NodeServicesTest, SpawnIntoOverlapIsReportedAndSeparatesWithoutLaunching) {
+  const auto response =
+      client_.SpawnUrdf("sunk_box", BoxUrdf(1.0, 1.0, 1.0, 1.0), MakePose(20.0, 20.0, 0.45));
+  ASSERT_TRUE(response.success) << response.message;
+  spawned_.push_back("sunk_box");
+  EXPECT_NE(response.message.find("overlaps 'ground' by 0.05 m"), std::string::npos)
+      << response.message;
+  const double limit = std::sqrt(2.0 * 9.81 * 0.05) + 0.1;
+  double fastest = 0.0;
+  for (int step = 0; step < 480; ++step) {
+    ASSERT_TRUE(client_.Step(1).success);
+    const auto state = client_.GetState("sunk_box");
+    const auto& v = state.twist.linear;
+    fastest = std::max(fastest, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+  }
+  EXPECT_LE(fastest, limit);
+  // At rest, sunk by the penetration slop (1e-4 m) the split impulse leaves.
+  EXPECT_NEAR(client_.GetState("sunk_box").pose.position.z, 0.5, 1e-4 + 1e-9);
+}
+
+// A URDF cylinder (r = 0.1 m) released on its side on a static ramp tilted
+// 10 degrees rolls without slipping: its centre accelerates at
+// (2/3) g sin(theta), so it covers g sin(theta) t^2 / 3 in t = 1 s.
+TEST_F(NodeServicesTest, UrdfCylinderRollsDownARampAtTwoThirdsGSinTheta) {
+  const double theta = 10.0 * M_PI / 180.0;
+  const double radius = 0.1;
+  rigid_body_sim::Spawn::Request ramp;
+  ramp.name = "roll_ramp";
+  ramp.urdf = BoxUrdf(20.0, 4.0, 1.0, 100.0);
+  ramp.is_static = true;
+  ramp.pose = MakePose(40.0, 40.0, 5.0, std::cos(theta / 2), 0.0, std::sin(theta / 2), 0.0);
+  ramp.friction = -1.0;
+  ramp.restitution = -1.0;
+  const auto ramp_reply = client_.Spawn(ramp);
+  ASSERT_TRUE(ramp_reply.success) << ramp_reply.message;
+  spawned_.push_back("roll_ramp");
+  // Ramp normal (sin, 0, cos), downhill (cos, 0, -sin); the cylinder's axis
+  // along y: the ramp's tilt times a quarter turn about x.
+  const double normal[3] = {std::sin(theta), 0.0, std::cos(theta)};
+  const double downhill[3] = {std::cos(theta), 0.0, -std::sin(theta)};
+  const double c = std::cos(theta / 2), s = std::sin(theta / 2), h = std::sqrt(0.5);
+  std::ostringstream urdf;
+  urdf << "<robot name=\"roller\"><link name=\"base_link\"><inertial><mass value=\"2\"/>"
+       << "<inertia ixx=\"0.02\" iyy=\"0.02\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+       << "</inertial><collision><geometry><cylinder radius=\"" << radius
+       << "\" length=\"0.3\"/></geometry></collision></link></robot>";
+  const double start[3] = {40.0 + 0.6 * normal[0] - 5.0 * downhill[0], 40.0,
+                           5.0 + 0.6 * normal[2] - 5.0 * downhill[2]};
+  const auto roller = client_.SpawnUrdf(
+      "roller", urdf.str(), MakePose(start[0], start[1], start[2], c * h, c * h, s * h, -s * h));
+  ASSERT_TRUE(roller.success) << roller.message;
+  spawned_.push_back("roller");
+  ASSERT_TRUE(client_.Step(240).success);
+  const auto state = client_.GetState("roller");
+  const double moved[3] = {state.pose.position.x - start[0], state.pose.position.y - start[1],
+                           state.pose.position.z - start[2]};
+  const double along = moved[0] * downhill[0] + moved[2] * downhill[2];
+  const double expected = 9.81 * std::sin(theta) / 3.0;
+  EXPECT_NEAR(along / expected, 1.0, 1e-4);
+  EXPECT_NEAR(moved[0] * normal[0] + moved[2] * normal[2], 0.0, 1e-6);
+}
+
 TEST_F(NodeServicesTest, BadInputIsRefusedAndChangesNothing) {
   SpawnBox("existing", MakePose(0.0, 0.0, 30.0));
   const int frames = FrameCount();

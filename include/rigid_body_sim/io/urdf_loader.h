@@ -37,7 +37,6 @@ struct UrdfLoadOptions {
   // computed from their collision geometry.
   double default_density = 1000.0;
   HullOptions hull;            // for <mesh> collisions
-  int cylinder_segments = 32;  // count, >= 3: sides of the prism standing in for a <cylinder>
   int max_links = 1000;        // count, >= 1: a model with more <link>s is refused
   // Bytes; a URDF or mesh file larger than this, or not a regular file
   // (/dev/zero, a FIFO), is refused before it is read.

@@ -39,11 +39,10 @@ struct NodeOptions {
   double ground_friction = 0.8;     // ~ground_friction: Coulomb mu, >= 0
   double ground_restitution = 0.0;  // ~ground_restitution: in [0, 1]
   MaterialDefaults defaults;  // ~default_friction (0.5, >= 0), ~default_restitution (0.0, [0, 1])
-  // ~default_density (kg/m^3, 1000), ~max_hull_vertices (count, 256),
-  // ~cylinder_segments (count, 32) for URDF loading.
+  // ~default_density (kg/m^3, 1000), ~max_hull_vertices (count, 256) for
+  // URDF loading.
   double default_density = 1000.0;
   int max_hull_vertices = 256;
-  int cylinder_segments = 32;
   double status_period = 5.0;  // ~status_period: s of real time between INFO status lines, > 0
   // ~contact_force_scale: m of contact-marker arrow per N of normal force, > 0
   double contact_force_scale = 0.02;

@@ -83,6 +83,7 @@ class SimNode {
   std::unique_lock<std::mutex> LockWorld();
 
   physics::Result<std::vector<std::string>> SpawnModel(const ModelSpec& spec);
+  std::string DescribeOverlaps(const std::string& model_name);
   physics::Result<io::LoadedModel> LoadModel(const ModelSpec& spec) const;
 
   bool OnSpawn(rigid_body_sim::Spawn::Request& request, rigid_body_sim::Spawn::Response& response);

@@ -33,6 +33,12 @@ struct ContactReport {
   double normal_force = 0.0;                   // N, normal_impulse / time_step
 };
 
+// A body that interpenetrates another, as World::FindOverlaps reports it.
+struct BodyOverlap {
+  BodyId other;
+  double depth = 0.0;  // m, deepest penetration of any shape pair, > 0
+};
+
 }  // namespace rigid_body_sim::physics
 
 #endif  // RIGID_BODY_SIM_PHYSICS_CONTACT_H_

@@ -17,8 +17,17 @@ struct Sphere {
 // The half-space z <= 0 of the shape frame; only static bodies may carry it.
 struct HalfSpace {};
 
-// Polyhedra are immutable and shared, so many bodies can use one hull.
-using ShapeGeometry = std::variant<Sphere, std::shared_ptr<const ConvexPolyhedron>, HalfSpace>;
+// A solid cylinder around the shape frame's z axis, centred at its origin
+// (URDF's convention), exact in the narrow phase.
+struct Cylinder {
+  double radius = 0.0;       // m
+  double half_length = 0.0;  // m, half the length along z
+};
+
+// Polyhedra are immutable and shared, so many bodies can use one hull. The
+// order of the alternatives is the narrow phase's dispatch order.
+using ShapeGeometry =
+    std::variant<Sphere, std::shared_ptr<const ConvexPolyhedron>, HalfSpace, Cylinder>;
 
 struct Material {
   double friction = 0.5;     // Coulomb coefficient mu, dimensionless, >= 0
@@ -31,7 +40,7 @@ struct ShapeDef {
   Material material;
 };
 
-// Checks a shape definition: finite pose, positive radius, non-empty polyhedron,
+// Checks a shape definition: finite pose, positive radius and length, non-empty polyhedron,
 // material in range.
 Status ValidateShapeDef(const ShapeDef& shape);
 

@@ -55,6 +55,11 @@ class World {
 
   // Advances the world by settings().time_step.
   void Step();
+  // The enabled bodies that `id` interpenetrates now, deepest first, each by
+  // its deepest point (an invalid id has none). The step separates such
+  // bodies by moving their positions only (the split impulse), so spawning
+  // into an overlap gives no launch speed.
+  std::vector<BodyOverlap> FindOverlaps(BodyId id) const;
   double time() const;  // s since creation or the last Restart
   const StepProfile& last_step_profile() const;
 

@@ -71,7 +71,8 @@ struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
   double time_step = 1.0 / 240.0;        // s, > 0
   // m; bounding boxes are fattened by this, and contact points are reported
-  // while the surfaces are closer than this plus the pair's motion in a step.
+  // while the surfaces are closer than this (at most a quarter of the
+  // thinner body's thickness) plus the pair's motion in a step.
   double contact_margin = 0.005;
   // A body moving more than this fraction of its thickness in one step is
   // sampled along its path, so it cannot pass through anything (0, 1].
