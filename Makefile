@@ -18,7 +18,7 @@ CMAKE_ARGS ?=
 CATKIN := catkin_make -C $(WS) -DPYTHON_EXECUTABLE=/usr/bin/python3 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_ARGS)
 
-.PHONY: demo test deps build test-sanitize test-tsan bench clean format
+.PHONY: demo test deps build test-sanitize test-tsan fuzz bench clean format
 
 # The demo scene without rviz for DEMO_SECONDS of real time, showing the
 # node's log (its status line comes every 5 s). Succeeds when the node
@@ -91,6 +91,34 @@ test-tsan: deps
 	@if ls $(WS_TSAN)/tsan.* > /dev/null 2>&1; then \
 	  cat $(WS_TSAN)/tsan.*; echo "[test-tsan] ThreadSanitizer reported a race" >&2; exit 1; fi
 	@echo "[test-tsan] no ThreadSanitizer reports"
+
+# libFuzzer harnesses (fuzz/) for the URDF loader, the mesh helper's parsing
+# and the node's request validation, built with clang under ASan and UBSan
+# in a plain CMake build of the ROS-free code. Each runs FUZZ_SECONDS on a
+# scratch copy of its seed corpus (fuzz/corpus/<name>); a crash, leak,
+# timeout or out-of-memory fails the target and leaves the input in
+# build/fuzz/artifacts.
+FUZZ_BUILD := $(ROOT)/build/fuzz
+FUZZ_SECONDS ?= 600
+FUZZERS := urdf_loader_fuzzer mesh_parser_fuzzer request_validation_fuzzer
+fuzz: deps
+	cmake -S $(ROOT) -B $(FUZZ_BUILD) -DRBS_CORE_ONLY=ON -DRBS_FUZZ=ON -DCMAKE_BUILD_TYPE=None \
+	  -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \
+	  -DCMAKE_CXX_FLAGS="-O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" \
+	  > /dev/null
+	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target $(FUZZERS) rigid_body_sim_mesh_helper
+	@mkdir -p $(FUZZ_BUILD)/artifacts
+	@for fuzzer in $(FUZZERS); do \
+	  name=$${fuzzer%_fuzzer}; rm -rf $(FUZZ_BUILD)/corpus/$$name; mkdir -p $(FUZZ_BUILD)/corpus/$$name; \
+	  cp $(ROOT)/fuzz/corpus/$$name/* $(FUZZ_BUILD)/corpus/$$name/; \
+	  echo "[fuzz] $$fuzzer for $(FUZZ_SECONDS) s"; \
+	  $(FUZZ_BUILD)/$$fuzzer -max_total_time=$(FUZZ_SECONDS) -timeout=30 -rss_limit_mb=2048 \
+	    -max_len=65536 -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/artifacts/$$name- \
+	    $(FUZZ_BUILD)/corpus/$$name > $(FUZZ_BUILD)/$$name.log 2>&1 \
+	    || { tail -40 $(FUZZ_BUILD)/$$name.log; echo "[fuzz] $$fuzzer failed" >&2; exit 1; }; \
+	  grep -E '^stat::number_of_executed_units|^#[0-9]+.*DONE' $(FUZZ_BUILD)/$$name.log | tail -2; \
+	done
+	@echo "[fuzz] no crash in $(FUZZERS)"
 
 # The benchmark scenes in our engine and side by side in Bullet (only this
 # build links Bullet), then the component benchmarks and the plot. A plain

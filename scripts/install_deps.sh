@@ -14,6 +14,7 @@ packages=(
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
   python3-geometry-msgs python3-std-msgs python3-std-srvs python3-visualization-msgs
   python3-rosgraph-msgs python3-tf2-msgs
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -117,7 +117,7 @@ Result<std::string> ResolveFileUri(const std::string& uri) {
 }
 
 Result<TriangleMesh> LoadMesh(const std::string& uri, const Vec3& scale,
-                              const UriResolver& resolver) {
+                              const UriResolver& resolver, std::uintmax_t max_file_bytes) {
   if (!scale.allFinite() || (scale.array() == 0.0).any()) {
     return Result<TriangleMesh>::Error("mesh '" + uri +
                                        "': scale must be finite and non-zero on every axis");
@@ -134,7 +134,14 @@ Result<TriangleMesh> LoadMesh(const std::string& uri, const Vec3& scale,
   }
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
-    return Result<TriangleMesh>::Error("mesh file '" + path + "' does not exist");
+    return Result<TriangleMesh>::Error("mesh file '" + path +
+                                       "' does not exist or is not a regular file");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error || size > max_file_bytes) {
+    return Result<TriangleMesh>::Error("mesh file '" + path + "' size " + std::to_string(size) +
+                                       " bytes is above the limit " +
+                                       std::to_string(max_file_bytes));
   }
 
   Assimp::Importer importer;

@@ -17,6 +17,8 @@
 #include <urdf_model/model.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "io/urdf_checks.h"
+
 namespace rigid_body_sim::io {
 namespace {
 
@@ -149,7 +151,13 @@ class ModelBuilder {
   ModelBuilder(const UrdfLoadOptions& options, UriResolver resolver)
       : options_(options), resolver_(std::move(resolver)) {}
 
-  Result<LoadedModel> Build(const std::string& xml) {
+  Result<LoadedModel> Build(const std::string& unpadded_xml) {
+    // TinyXML (ours and urdfdom's) steps over a UTF-8 sequence by the length
+    // its lead byte announces (at most 4) without looking for the end of the
+    // text: urdf_loader_fuzzer caught it reading 12 bytes past the end of a
+    // document ending in such a byte. Trailing NULs keep those reads inside
+    // the string, and end the name or value being read.
+    const std::string xml = unpadded_xml + std::string(16, '\0');
     TiXmlDocument document;
     document.Parse(xml.c_str());
     if (document.Error()) {
@@ -161,6 +169,7 @@ class ModelBuilder {
     if (robot == nullptr || robot->ValueStr() != "robot") {
       return Result<LoadedModel>::Error("URDF root element must be <robot>");
     }
+    if (Status status = CheckUrdfDocument(*robot, options_); !status.ok()) return status;
     Result<std::map<std::string, double>> friction = ReadGazeboFriction(*robot);
     if (!friction.ok()) return friction.status();
     friction_ = std::move(friction).value();
@@ -215,7 +224,7 @@ class ModelBuilder {
     loaded.root_link = body_root->name;
 
     std::vector<MassProperties> parts_in_root;
-    const Status status = AddLink(*body_root, Pose::Identity(), &loaded, &parts_in_root);
+    const Status status = AddLinks(*body_root, &loaded, &parts_in_root);
     if (!status.ok()) return status;
     if (loaded.shapes.empty()) {
       return Result<LoadedModel>::Error("model " + Quoted(loaded.name) +
@@ -232,7 +241,35 @@ class ModelBuilder {
     return loaded;
   }
 
-  // Adds `link` and, through their fixed joints, all links below it.
+  // Adds `root` and, through their fixed joints, all links below it, in
+  // depth-first order with an explicit stack: a chain of thousands of links
+  // must not overflow the call stack.
+  Status AddLinks(const urdf::Link& root, LoadedModel* loaded,
+                  std::vector<MassProperties>* parts_in_root) {
+    std::vector<std::pair<const urdf::Link*, Pose>> pending = {{&root, Pose::Identity()}};
+    while (!pending.empty()) {
+      const auto [link, root_from_link] = pending.back();
+      pending.pop_back();
+      if (Status status = AddLink(*link, root_from_link, loaded, parts_in_root); !status.ok()) {
+        return status;
+      }
+      // Pushed in reverse, so the first child is visited next.
+      for (auto joint = link->child_joints.rbegin(); joint != link->child_joints.rend(); ++joint) {
+        urdf::LinkConstSharedPtr child;
+        for (const urdf::LinkSharedPtr& candidate : link->child_links) {
+          if (candidate->name == (*joint)->child_link_name) child = candidate;
+        }
+        if (child == nullptr) {
+          return Status::Error("joint " + Quoted((*joint)->name) + " has no child link");
+        }
+        pending.emplace_back(child.get(),
+                             root_from_link * ToPose((*joint)->parent_to_joint_origin_transform));
+      }
+    }
+    return Status::Ok();
+  }
+
+  // Adds the shapes and the mass of one link.
   Status AddLink(const urdf::Link& link, const Pose& root_from_link, LoadedModel* loaded,
                  std::vector<MassProperties>* parts_in_root) {
     loaded->links.push_back(LinkFrame{link.name, root_from_link});
@@ -277,19 +314,6 @@ class ModelBuilder {
                                    FormatNumber(options_.default_density) + " kg/m^3");
       }
     }
-
-    for (const urdf::JointSharedPtr& joint : link.child_joints) {
-      urdf::LinkConstSharedPtr child;
-      for (const urdf::LinkSharedPtr& candidate : link.child_links) {
-        if (candidate->name == joint->child_link_name) child = candidate;
-      }
-      if (child == nullptr) {
-        return Status::Error("joint " + Quoted(joint->name) + " has no child link");
-      }
-      const Pose root_from_child = root_from_link * ToPose(joint->parent_to_joint_origin_transform);
-      const Status status = AddLink(*child, root_from_child, loaded, parts_in_root);
-      if (!status.ok()) return status;
-    }
     return Status::Ok();
   }
 
@@ -298,9 +322,11 @@ class ModelBuilder {
     switch (geometry.type) {
       case urdf::Geometry::SPHERE: {
         const double radius = static_cast<const urdf::Sphere&>(geometry).radius;
-        if (!PositiveFinite(radius)) {
-          return Result<ShapeWithMass>::Error(where + ": sphere radius must be positive, got " +
-                                              FormatNumber(radius));
+        if (!(radius >= kMinShapeSize && radius <= kMaxShapeSize)) {
+          return Result<ShapeWithMass>::Error(where + " <sphere> radius " + FormatNumber(radius) +
+                                              " m is outside the allowed range [" +
+                                              FormatNumber(kMinShapeSize) + ", " +
+                                              FormatNumber(kMaxShapeSize) + "] m");
         }
         return ShapeWithMass{physics::Sphere{radius},
                              physics::SphereMassProperties(density, radius)};
@@ -311,15 +337,25 @@ class ModelBuilder {
         if (!PositiveFinite(size.x()) || !PositiveFinite(size.y()) || !PositiveFinite(size.z())) {
           return Result<ShapeWithMass>::Error(where + ": box size must be positive on every axis");
         }
-        return ShapeWithMass{
-            std::make_shared<const ConvexPolyhedron>(physics::MakeBoxPolyhedron(size)),
-            physics::BoxMassProperties(density, size)};
+        if (Status status = CheckShapeExtents(size, where + " <box>"); !status.ok()) {
+          return status;
+        }
+        Result<ConvexPolyhedron> box = physics::TryMakeBoxPolyhedron(size);
+        if (!box.ok()) return Result<ShapeWithMass>::Error(where + ": " + box.message());
+        return ShapeWithMass{std::make_shared<const ConvexPolyhedron>(std::move(box).value()),
+                             physics::BoxMassProperties(density, size)};
       }
       case urdf::Geometry::CYLINDER: {
         const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
         if (!PositiveFinite(cylinder.radius) || !PositiveFinite(cylinder.length)) {
           return Result<ShapeWithMass>::Error(where +
                                               ": cylinder radius and length must be positive");
+        }
+        const double diameter = 2.0 * cylinder.radius;
+        if (Status status =
+                CheckShapeExtents(Vec3(diameter, diameter, cylinder.length), where + " <cylinder>");
+            !status.ok()) {
+          return status;
         }
         return ShapeWithMass{
             physics::Cylinder{cylinder.radius, 0.5 * cylinder.length},
@@ -330,6 +366,16 @@ class ModelBuilder {
         const Vec3 scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
         Result<std::shared_ptr<const ConvexPolyhedron>> hull = MeshHull(mesh.filename, scale);
         if (!hull.ok()) return Result<ShapeWithMass>::Error(where + ": " + hull.message());
+        Vec3 lower = (*hull)->vertices.front();
+        Vec3 upper = lower;
+        for (const Vec3& vertex : (*hull)->vertices) {
+          lower = lower.cwiseMin(vertex);
+          upper = upper.cwiseMax(vertex);
+        }
+        if (Status status = CheckShapeExtents(upper - lower, where + " <mesh> hull");
+            !status.ok()) {
+          return status;
+        }
         return ShapeWithMass{*hull, physics::PolyhedronMassProperties(density, **hull)};
       }
     }
@@ -343,7 +389,18 @@ class ModelBuilder {
     const auto key = std::make_tuple(uri, scale.x(), scale.y(), scale.z());
     const auto cached = hulls_.find(key);
     if (cached != hulls_.end()) return cached->second;
-    Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_);
+    if (options_.mesh_hull_loader) {
+      const Result<std::string> path = resolver_(uri);
+      if (!path.ok()) {
+        return Result<std::shared_ptr<const ConvexPolyhedron>>::Error("mesh " + Quoted(uri) + ": " +
+                                                                      path.message());
+      }
+      Result<std::shared_ptr<const ConvexPolyhedron>> loaded =
+          options_.mesh_hull_loader(*path, scale, options_.hull);
+      if (loaded.ok()) hulls_.emplace(key, *loaded);
+      return loaded;
+    }
+    Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_, options_.max_file_bytes);
     if (!mesh.ok()) return mesh.status();
     Result<ConvexPolyhedron> hull = ComputeConvexHull(mesh->vertices, options_.hull);
     if (!hull.ok()) {
@@ -367,6 +424,10 @@ Status ValidateOptions(const UrdfLoadOptions& options) {
     return Status::Error("URDF load option default_density must be positive and finite, got " +
                          FormatNumber(options.default_density));
   }
+  if (options.max_links < 1) {
+    return Status::Error("URDF load option max_links must be at least 1, got " +
+                         std::to_string(options.max_links));
+  }
   if (options.hull.max_vertices < 4) {
     return Status::Error("URDF load option hull.max_vertices must be at least 4, got " +
                          std::to_string(options.hull.max_vertices));
@@ -389,6 +450,19 @@ Result<LoadedModel> LoadUrdfString(const std::string& xml, const UrdfLoadOptions
 Result<LoadedModel> LoadUrdfFile(const std::string& path, const UrdfLoadOptions& options) {
   const Status status = ValidateOptions(options);
   if (!status.ok()) return status;
+  // Checked before reading: /dev/zero would fill the memory, a FIFO would
+  // block the caller.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    return Result<LoadedModel>::Error("URDF file " + Quoted(path) +
+                                      " does not exist or is not a regular file");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error || size > options.max_file_bytes) {
+    return Result<LoadedModel>::Error("URDF file " + Quoted(path) + " size " +
+                                      std::to_string(size) + " bytes is above the limit " +
+                                      std::to_string(options.max_file_bytes));
+  }
   std::ifstream file(path, std::ios::binary);
   if (!file) return Result<LoadedModel>::Error("URDF file " + Quoted(path) + " cannot be read");
   std::ostringstream contents;

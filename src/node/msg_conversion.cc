@@ -5,6 +5,8 @@
 #include <memory>
 #include <variant>
 
+#include "rigid_body_sim/node/request_validation.h"
+
 namespace rigid_body_sim::node {
 
 using physics::Pose;
@@ -14,8 +16,6 @@ using physics::Status;
 using physics::Vec3;
 
 namespace {
-
-constexpr double kMinQuaternionNorm = 1e-9;
 
 std_msgs::ColorRGBA Color(float r, float g, float b, float a) {
   std_msgs::ColorRGBA color;
@@ -38,15 +38,28 @@ visualization_msgs::Marker BaseMarker(const std::string& ns, int id, const std::
 
 }  // namespace
 
+namespace {
+
+std::string Describe(const Vec3& v) {
+  return "[" + physics::FormatNumber(v.x()) + ", " + physics::FormatNumber(v.y()) + ", " +
+         physics::FormatNumber(v.z()) + "]";
+}
+
+}  // namespace
+
 Result<Vec3> VectorFromMsg(const geometry_msgs::Vector3& msg, const std::string& field) {
   const Vec3 vector(msg.x, msg.y, msg.z);
-  if (!vector.allFinite()) return Result<Vec3>::Error(field + " is not finite");
+  if (!vector.allFinite()) {
+    return Result<Vec3>::Error(field + " " + Describe(vector) + " is not finite");
+  }
   return vector;
 }
 
 Result<Vec3> PointFromMsg(const geometry_msgs::Point& msg, const std::string& field) {
   const Vec3 point(msg.x, msg.y, msg.z);
-  if (!point.allFinite()) return Result<Vec3>::Error(field + " is not finite");
+  if (!point.allFinite()) {
+    return Result<Vec3>::Error(field + " " + Describe(point) + " is not finite");
+  }
   return point;
 }
 
@@ -54,13 +67,25 @@ Result<Pose> PoseFromMsg(const geometry_msgs::Pose& msg, const std::string& fiel
   Result<Vec3> position = PointFromMsg(msg.position, field + ".position");
   if (!position.ok()) return position.status();
   Quat rotation(msg.orientation.w, msg.orientation.x, msg.orientation.y, msg.orientation.z);
-  if (!rotation.coeffs().allFinite()) {
-    return Result<Pose>::Error(field + ".orientation is not finite");
+  const std::string shown =
+      field + ".orientation (w, x, y, z) = (" + physics::FormatNumber(rotation.w()) + ", " +
+      physics::FormatNumber(rotation.x()) + ", " + physics::FormatNumber(rotation.y()) + ", " +
+      physics::FormatNumber(rotation.z()) + ")";
+  if (!rotation.coeffs().allFinite()) return Result<Pose>::Error(shown + " is not finite");
+  // stableNorm: a quaternion of 1e200s has a finite norm that norm() would
+  // overflow, and normalising by infinity would leave a zero quaternion.
+  const double norm = rotation.coeffs().stableNorm();
+  const std::string range = " outside the allowed range [" +
+                            physics::FormatNumber(kMinQuaternionNorm) + ", " +
+                            physics::FormatNumber(kMaxQuaternionNorm) + "]";
+  if (norm < kMinQuaternionNorm) {
+    return Result<Pose>::Error(shown + " is a zero quaternion: norm " +
+                               physics::FormatNumber(norm) + range);
   }
-  if (rotation.norm() < kMinQuaternionNorm) {
-    return Result<Pose>::Error(field + ".orientation is a zero quaternion");
+  if (!(norm <= kMaxQuaternionNorm)) {
+    return Result<Pose>::Error(shown + " has norm " + physics::FormatNumber(norm) + range);
   }
-  rotation.normalize();
+  rotation.coeffs() /= norm;
   return Pose{*position, rotation};
 }
 
@@ -135,7 +160,14 @@ geometry_msgs::TransformStamped TransformToMsg(const Pose& parent_from_child,
   return msg;
 }
 
-ros::Time SimTimeToRos(double sim_time) { return ros::Time(std::max(sim_time, 0.0)); }
+ros::Time SimTimeToRos(double sim_time) {
+  // ros::Time throws beyond 2^32 - 1 s ("Time is out of dual 32-bit range");
+  // a stamp is clamped instead, and NaN becomes 0.
+  constexpr double kMaxRosSeconds = 4294967295.0;
+  if (!(sim_time > 0.0)) return ros::Time(0);
+  if (sim_time >= kMaxRosSeconds) return ros::TIME_MAX;
+  return ros::Time(sim_time);
+}
 
 rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
                                      const std::string& body_a, const std::string& body_b) {

@@ -5,6 +5,7 @@
 #include <type_traits>
 #include <variant>
 
+#include <ros/console.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 namespace rigid_body_sim::node {
@@ -141,20 +142,34 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     return Status::Error("~world_frame '" + options.world_frame +
                          "' starts with '/'; tf2 frame ids have no leading slash");
   }
-  if (!physics::IsFinite(options.world.gravity)) return Status::Error("~gravity is not finite");
-  if (!(options.world.time_step > 0.0) || !std::isfinite(options.world.time_step)) {
-    return Status::Error("~time_step " + FormatNumber(options.world.time_step) +
-                         " s must be positive and finite");
+  for (const Status& status :
+       {ValidateGravity(options.world.gravity, "~gravity"),
+        ValidateTimeStep(options.world.time_step, "~time_step"),
+        ValidateRealTimeFactor(options.real_time_factor, "~real_time_factor"),
+        ValidateRequestLimits(options.limits)}) {
+    if (!status.ok()) return status;
+  }
+  if (options.max_links_per_model < 1) {
+    return Status::Error("~max_links_per_model " + std::to_string(options.max_links_per_model) +
+                         " must be >= 1");
+  }
+  if (options.mesh_memory_limit < (1 << 24)) {
+    return Status::Error("~mesh_memory_limit " + std::to_string(options.mesh_memory_limit) +
+                         " bytes is below the allowed 16777216");
+  }
+  if (!(options.mesh_cpu_limit > 0.0 && options.mesh_cpu_limit <= 3600.0)) {
+    return Status::Error("~mesh_cpu_limit " + FormatNumber(options.mesh_cpu_limit) +
+                         " s is outside the allowed range (0, 3600] s");
+  }
+  if (options.max_file_bytes < 1) {
+    return Status::Error("~max_file_bytes " + std::to_string(options.max_file_bytes) +
+                         " must be >= 1");
   }
   if (Status status = physics::ValidateWorldSettings(options.world); !status.ok()) {
     return Status::Error(
         "world settings (~gravity, ~time_step, ~contact_margin, "
         "~continuous_fraction, ~solver, ~sleep): " +
         status.message());
-  }
-  if (!(options.real_time_factor >= 0.0) || !std::isfinite(options.real_time_factor)) {
-    return Status::Error("~real_time_factor " + FormatNumber(options.real_time_factor) +
-                         " must be >= 0 (0: as fast as possible)");
   }
   if (!(options.publish_rate > 0.0) || !std::isfinite(options.publish_rate)) {
     return Status::Error("~publish_rate " + FormatNumber(options.publish_rate) +
@@ -203,6 +218,9 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     }
     if (spec.urdf.empty() && spec.urdf_path.empty()) {
       return Status::Error("~models: '" + spec.name + "' has neither urdf nor urdf_path");
+    }
+    if (Status status = ValidateModelSpec(spec, options.limits); !status.ok()) {
+      return Status::Error("~models: '" + spec.name + "': " + status.message());
     }
   }
   return Status::Ok();
@@ -255,6 +273,17 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"sleep/speeding_up_time", &sleep.speeding_up_time},
       {"status_period", &options->status_period},
       {"contact_force_scale", &options->contact_force_scale},
+      {"max_position", &options->limits.max_position},
+      {"max_linear_speed", &options->limits.max_linear_speed},
+      {"max_angular_speed", &options->limits.max_angular_speed},
+      {"max_force", &options->limits.max_force},
+      {"max_torque", &options->limits.max_torque},
+      {"max_wrench_duration", &options->limits.max_wrench_duration},
+      {"max_step_count", &options->limits.max_step_count},
+      {"max_links_per_model", &options->max_links_per_model},
+      {"max_file_bytes", &options->max_file_bytes},
+      {"mesh_memory_limit", &options->mesh_memory_limit},
+      {"mesh_cpu_limit", &options->mesh_cpu_limit},
   };
 }
 
@@ -315,6 +344,10 @@ Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node) {
   }
   if (Status status = ReadModels(private_node, &options.models); !status.ok()) return status;
   if (Status status = ValidateNodeOptions(options); !status.ok()) return status;
+  if (options.world.time_step > kWarnTimeStep) {
+    ROS_WARN("~time_step %g s is above %g s: contacts and fast bodies will be coarse",
+             options.world.time_step, kWarnTimeStep);
+  }
   return options;
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
+#include <exception>
+#include <string>
 
 #include "rigid_body_sim/node/sim_node.h"
 
@@ -33,6 +35,22 @@ void SimNode::StepLocked() {
                   wrenches_.end());
   world_.Step();
   ++steps_;
+  if (!world_.non_finite_bodies().empty()) ReportFrozenLocked();
+}
+
+void SimNode::ReportFrozenLocked() {
+  for (const physics::BodyId body : world_.non_finite_bodies()) {
+    wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(),
+                                   [body](const ActiveWrench& w) { return w.body == body; }),
+                    wrenches_.end());
+    const Model* model = registry_.FindByBody(body);
+    const std::string name = model != nullptr ? model->name : "(unnamed body)";
+    frozen_models_.insert(name);
+    ROS_ERROR(
+        "model '%s' frozen at sim time %.6f s: its state stopped being finite or grew beyond "
+        "1e100; held at its last finite pose, out of the simulation, until ~set_state or ~reset",
+        name.c_str(), world_.time());
+  }
 }
 
 void SimNode::ReanchorLocked() {
@@ -52,7 +70,7 @@ void SimNode::StepLoop() {
   Clock::time_point next_status = Clock::now() + status_period;
   for (;;) {
     Outbox outbox;
-    {
+    try {
       std::unique_lock<std::mutex> lock(mutex_);
       if (shutdown_) return;
       if (paused_) {
@@ -89,8 +107,19 @@ void SimNode::StepLoop() {
         LogStatusLocked(now);
         next_status = now + status_period;
       }
+    } catch (const std::exception& error) {
+      // Stepping on would likely throw again at once; pausing keeps the
+      // node answering, and ~set_paused resumes.
+      std::lock_guard<std::mutex> lock(mutex_);
+      paused_ = true;
+      ROS_ERROR("step loop: %s; simulation paused", error.what());
+      continue;
     }
-    Publish(std::move(outbox));
+    try {
+      Publish(std::move(outbox));
+    } catch (const std::exception& error) {
+      ROS_ERROR_THROTTLE(5.0, "publishing: %s", error.what());
+    }
     // Service callers waiting for the mutex go first, so a flat-out loop
     // cannot starve them.
     while (waiting_.load(std::memory_order_acquire) > 0) std::this_thread::yield();

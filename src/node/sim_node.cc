@@ -3,11 +3,17 @@
 #include "rigid_body_sim/node/sim_node.h"
 
 #include <cassert>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <type_traits>
 #include <utility>
 
 #include <rosgraph_msgs/Clock.h>
 
 #include "node/ros_uri.h"
+#include "rigid_body_sim/io/mesh_process.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 
@@ -16,6 +22,18 @@ namespace rigid_body_sim::node {
 using physics::BodyId;
 using physics::Result;
 using physics::Status;
+
+namespace {
+
+// The mesh helper is built next to the node (devel/lib/rigid_body_sim, or
+// the installed package's lib directory).
+std::string MeshHelperPath() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return (self.parent_path() / "rigid_body_sim_mesh_helper").string();
+}
+
+}  // namespace
 
 SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle private_node)
     : options_(std::move(options)),
@@ -26,6 +44,19 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       real_time_factor_(options_.real_time_factor) {
   load_options_.default_density = options_.default_density;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
+  load_options_.max_links = options_.max_links_per_model;
+  load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);
+  // Meshes are untrusted files: assimp and qhull run in the helper process.
+  io::MeshProcessLimits mesh_limits;
+  mesh_limits.helper_path = MeshHelperPath();
+  mesh_limits.memory_bytes = static_cast<std::uint64_t>(options_.mesh_memory_limit);
+  mesh_limits.cpu_seconds = options_.mesh_cpu_limit;
+  mesh_limits.max_file_bytes = static_cast<std::uint64_t>(options_.max_file_bytes);
+  load_options_.mesh_hull_loader = [mesh_limits](const std::string& path,
+                                                 const physics::Vec3& scale,
+                                                 const io::HullOptions& hull) {
+    return io::CachedMeshHull(path, scale, hull, mesh_limits);
+  };
   load_options_.resolver = ResolveRosUri;
 }
 
@@ -43,6 +74,41 @@ std::unique_lock<std::mutex> SimNode::LockWorld() {
   std::unique_lock<std::mutex> lock(mutex_);
   waiting_.fetch_sub(1, std::memory_order_acq_rel);
   return lock;
+}
+
+namespace {
+
+// Whether a service response has the success and message fields.
+template <typename Response, typename = void>
+struct HasSuccess : std::false_type {};
+template <typename Response>
+struct HasSuccess<Response, std::void_t<decltype(std::declval<Response&>().success),
+                                        decltype(std::declval<Response&>().message)>>
+    : std::true_type {};
+
+}  // namespace
+
+template <typename Request, typename Response>
+ros::ServiceServer SimNode::Advertise(const char* name,
+                                      bool (SimNode::*method)(Request& request,
+                                                              Response& response)) {
+  const boost::function<bool(Request&, Response&)> guarded =
+      [this, method, name](Request& request, Response& response) {
+        try {
+          return (this->*method)(request, response);
+        } catch (const std::exception& error) {
+          ROS_ERROR("~%s: %s", name, error.what());
+          response = Response();
+          if constexpr (HasSuccess<Response>::value) {
+            response.success = false;
+            response.message = std::string("internal error: ") + error.what();
+            return true;
+          } else {
+            return false;  // no field to say why: the call fails
+          }
+        }
+      };
+  return private_node_.advertiseService<Request, Response>(name, guarded);
 }
 
 Status SimNode::Start() {
@@ -84,22 +150,17 @@ Status SimNode::Start() {
   }
 
   using Self = SimNode;
-  services_.push_back(private_node_.advertiseService(names::kSpawnService, &Self::OnSpawn, this));
-  services_.push_back(private_node_.advertiseService(names::kDeleteService, &Self::OnDelete, this));
-  services_.push_back(private_node_.advertiseService(names::kResetService, &Self::OnReset, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kSetPausedService, &Self::OnSetPaused, this));
-  services_.push_back(private_node_.advertiseService(names::kStepService, &Self::OnStep, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kGetStateService, &Self::OnGetState, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kSetStateService, &Self::OnSetState, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kApplyWrenchService, &Self::OnApplyWrench, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kGetPhysicsService, &Self::OnGetPhysics, this));
-  services_.push_back(
-      private_node_.advertiseService(names::kSetPhysicsService, &Self::OnSetPhysics, this));
+  services_.push_back(Advertise(names::kSpawnService, &Self::OnSpawn));
+  services_.push_back(Advertise(names::kDeleteService, &Self::OnDelete));
+  services_.push_back(Advertise(names::kResetService, &Self::OnReset));
+  services_.push_back(Advertise(names::kSetPausedService, &Self::OnSetPaused));
+  services_.push_back(Advertise(names::kStepService, &Self::OnStep));
+  services_.push_back(Advertise(names::kCancelStepService, &Self::OnCancelStep));
+  services_.push_back(Advertise(names::kGetStateService, &Self::OnGetState));
+  services_.push_back(Advertise(names::kSetStateService, &Self::OnSetState));
+  services_.push_back(Advertise(names::kApplyWrenchService, &Self::OnApplyWrench));
+  services_.push_back(Advertise(names::kGetPhysicsService, &Self::OnGetPhysics));
+  services_.push_back(Advertise(names::kSetPhysicsService, &Self::OnSetPhysics));
 
   {
     std::lock_guard<std::mutex> lock(mutex_);

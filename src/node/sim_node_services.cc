@@ -2,11 +2,13 @@
 // under its lock, or changes nothing and says why.
 #include <algorithm>
 #include <cassert>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
+#include "rigid_body_sim/node/request_validation.h"
 #include "rigid_body_sim/node/sim_node.h"
 
 namespace rigid_body_sim::node {
@@ -33,6 +35,9 @@ bool SimNode::OnSpawn(rigid_body_sim::Spawn::Request& request,
                       rigid_body_sim::Spawn::Response& response) {
   Result<ModelSpec> spec = ModelSpecFromMsg(request);
   if (!spec.ok()) return Fail(response, spec.message(), names::kSpawnService);
+  if (Status status = ValidateModelSpec(*spec, options_.limits); !status.ok()) {
+    return Fail(response, status.message(), names::kSpawnService);
+  }
   Result<std::vector<std::string>> frames = SpawnModel(*spec);
   if (!frames.ok()) {
     return Fail(response, "cannot spawn '" + request.name + "': " + frames.message(),
@@ -80,6 +85,7 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
                                    [body](const ActiveWrench& w) { return w.body == body; }),
                     wrenches_.end());
     registry_.Remove(request.name);
+    frozen_models_.erase(request.name);
     const int marker_count = static_cast<int>(body_markers_[request.name].size());
     body_markers_.erase(request.name);
     outbox.body_markers.emplace().markers = DeleteMarkers(request.name, marker_count);
@@ -104,6 +110,7 @@ bool SimNode::OnReset(std_srvs::Trigger::Request& /*request*/,
     }
     world_.Restart();
     wrenches_.clear();
+    frozen_models_.clear();
     last_periodic_time_ = -1.0;
     ReanchorLocked();
     status_wall_ = Clock::now();
@@ -130,6 +137,7 @@ bool SimNode::OnSetPaused(std_srvs::SetBool::Request& request,
     std::unique_lock<std::mutex> lock = LockWorld();
     paused_ = request.data;
     ReanchorLocked();
+    if (step_in_progress_) cancel_step_ = names::kSetPausedService;
   }
   wake_.notify_all();
   response.success = true;
@@ -137,24 +145,87 @@ bool SimNode::OnSetPaused(std_srvs::SetBool::Request& request,
   return true;
 }
 
+namespace {
+
+// A long ~step call holds the world for at most this long at a time, so that
+// other services answer and the loop publishes between its chunks.
+constexpr std::chrono::milliseconds kStepChunk(10);
+
+}  // namespace
+
 bool SimNode::OnStep(rigid_body_sim::Step::Request& request,
                      rigid_body_sim::Step::Response& response) {
-  Outbox outbox;
+  const char* service = names::kStepService;
+  if (Status status = ValidateStepCount(request.steps, options_.limits); !status.ok()) {
+    return Fail(response, status.message(), service);
+  }
+  std::lock_guard<std::mutex> one_call(step_service_mutex_);
   {
     std::unique_lock<std::mutex> lock = LockWorld();
-    if (!paused_) {
-      response.sim_time = world_.time();
-      return Fail(response, "step is only allowed while paused; call ~set_paused with true first",
-                  names::kStepService);
-    }
-    for (std::uint32_t i = 0; i < request.steps; ++i) StepLocked();
-    ReanchorLocked();
-    FillPeriodicLocked(&outbox);
     response.sim_time = world_.time();
+    if (!paused_) {
+      return Fail(response, "step is only allowed while paused; call ~set_paused with true first",
+                  service);
+    }
+    step_in_progress_ = true;
+    cancel_step_.clear();
   }
-  Publish(std::move(outbox));
+  // Whatever ends the call, even an exception, ends the step in progress.
+  struct StepCallEnd {
+    SimNode* node;
+    ~StepCallEnd() {
+      std::unique_lock<std::mutex> lock = node->LockWorld();
+      node->step_in_progress_ = false;
+    }
+  } step_call_end{this};
+  std::uint32_t done = 0;
+  std::string stopped_by;
+  while (stopped_by.empty()) {
+    Outbox outbox;
+    {
+      std::unique_lock<std::mutex> lock = LockWorld();
+      if (!cancel_step_.empty()) {
+        stopped_by = cancel_step_;
+      } else if (!paused_) {
+        stopped_by = names::kSetPausedService;
+      } else {
+        const auto chunk_end = Clock::now() + kStepChunk;
+        while (done < request.steps && Clock::now() < chunk_end) {
+          StepLocked();
+          ++done;
+        }
+        ReanchorLocked();
+        if (done == request.steps) stopped_by = "done";
+      }
+      if (!stopped_by.empty()) FillPeriodicLocked(&outbox);
+      response.sim_time = world_.time();
+    }
+    Publish(std::move(outbox));
+    // Callers waiting for the world go first, as in the step loop.
+    while (waiting_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
+  }
+  if (stopped_by != "done") {
+    return Fail(response,
+                "stopped by ~" + stopped_by + " after " + std::to_string(done) + " of " +
+                    std::to_string(request.steps) + " steps",
+                service);
+  }
   response.success = true;
-  response.message = "advanced " + std::to_string(request.steps) + " steps";
+  response.message = "advanced " + std::to_string(done) + " steps";
+  return true;
+}
+
+bool SimNode::OnCancelStep(std_srvs::Trigger::Request& /*request*/,
+                           std_srvs::Trigger::Response& response) {
+  std::unique_lock<std::mutex> lock = LockWorld();
+  if (!step_in_progress_) {
+    response.success = false;
+    response.message = "no ~step call in progress";
+    return true;
+  }
+  cancel_step_ = names::kCancelStepService;
+  response.success = true;
+  response.message = "the ~step call in progress stops after its current chunk";
   return true;
 }
 
@@ -166,6 +237,11 @@ bool SimNode::OnGetState(rigid_body_sim::GetState::Request& request,
   const FrameState state =
       LinkStateFromRoot(RootStateLocked(*frame->model), frame->link->root_from_link);
   response.success = true;
+  if (frozen_models_.count(frame->model->name) != 0) {
+    response.message =
+        "frozen: its state stopped being finite; held at its last finite pose "
+        "until ~set_state or ~reset";
+  }
   response.pose = PoseToMsg(state.world_from_frame);
   response.twist = TwistToMsg(state.linear_velocity, state.angular_velocity);
   return true;
@@ -175,6 +251,9 @@ bool SimNode::OnSetState(rigid_body_sim::SetState::Request& request,
                          rigid_body_sim::SetState::Response& response) {
   Result<FrameState> link_state = FrameStateFromMsg(request.pose, request.twist);
   if (!link_state.ok()) return Fail(response, link_state.message(), names::kSetStateService);
+  if (Status status = ValidateFrameState(*link_state, options_.limits); !status.ok()) {
+    return Fail(response, status.message(), names::kSetStateService);
+  }
   Outbox outbox;
   {
     std::unique_lock<std::mutex> lock = LockWorld();
@@ -188,6 +267,7 @@ bool SimNode::OnSetState(rigid_body_sim::SetState::Request& request,
     const Status status = world_.SetState(frame->model->body, root.world_from_frame,
                                           root.linear_velocity, root.angular_velocity);
     if (!status.ok()) return Fail(response, status.message(), names::kSetStateService);
+    frozen_models_.erase(frame->model->name);
     if (frame->model->is_static) outbox.tf_static = StaticTfLocked();
   }
   Publish(std::move(outbox));
@@ -205,10 +285,9 @@ bool SimNode::OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
   if (!force.ok()) return Fail(response, force.message(), service);
   Result<Vec3> torque = VectorFromMsg(request.wrench.torque, "wrench.torque");
   if (!torque.ok()) return Fail(response, torque.message(), service);
-  if (!(request.duration >= 0.0) || !std::isfinite(request.duration)) {
-    return Fail(response,
-                "duration " + FormatNumber(request.duration) + " s must be >= 0 and finite",
-                service);
+  if (Status status = ValidateWrench(*force, *torque, *point, request.duration, options_.limits);
+      !status.ok()) {
+    return Fail(response, status.message(), service);
   }
   std::unique_lock<std::mutex> lock = LockWorld();
   Result<FrameRef> frame = registry_.ResolveFrame(request.name);
@@ -218,8 +297,7 @@ bool SimNode::OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
   }
   // The wrench acts for the steps that cover `duration` at the current time
   // step, at least one.
-  const std::int64_t steps =
-      std::max<std::int64_t>(1, std::llround(request.duration / world_.settings().time_step));
+  const std::int64_t steps = WrenchSteps(request.duration, world_.settings().time_step);
   wrenches_.push_back(ActiveWrench{frame->model->body, *force, *point, *torque, steps});
   response.success = true;
   response.message = "wrench on '" + request.name + "' for " + std::to_string(steps) + " steps";
@@ -240,15 +318,14 @@ bool SimNode::OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
   const char* service = names::kSetPhysicsService;
   Result<Vec3> gravity = VectorFromMsg(request.gravity, "gravity");
   if (!gravity.ok()) return Fail(response, gravity.message(), service);
-  if (!(request.time_step > 0.0) || !std::isfinite(request.time_step)) {
-    return Fail(response, "time_step " + FormatNumber(request.time_step) + " s must be positive",
-                service);
+  for (const Status& status :
+       {ValidateGravity(*gravity, "gravity"), ValidateTimeStep(request.time_step, "time_step"),
+        ValidateRealTimeFactor(request.real_time_factor, "real_time_factor")}) {
+    if (!status.ok()) return Fail(response, status.message(), service);
   }
-  if (!(request.real_time_factor >= 0.0) || !std::isfinite(request.real_time_factor)) {
-    return Fail(response,
-                "real_time_factor " + FormatNumber(request.real_time_factor) +
-                    " must be >= 0 (0: as fast as possible)",
-                service);
+  if (request.time_step > kWarnTimeStep) {
+    ROS_WARN("~set_physics: time_step %g s is above %g s: contacts and fast bodies will be coarse",
+             request.time_step, kWarnTimeStep);
   }
   {
     std::unique_lock<std::mutex> lock = LockWorld();
@@ -268,14 +345,18 @@ bool SimNode::OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
 }
 
 void SimNode::OnBodyMarkersSubscriber(const ros::SingleSubscriberPublisher& publisher) {
-  visualization_msgs::MarkerArray array;
-  {
-    std::unique_lock<std::mutex> lock = LockWorld();
-    for (const auto& [name, markers] : body_markers_) {
-      array.markers.insert(array.markers.end(), markers.begin(), markers.end());
+  try {
+    visualization_msgs::MarkerArray array;
+    {
+      std::unique_lock<std::mutex> lock = LockWorld();
+      for (const auto& [name, markers] : body_markers_) {
+        array.markers.insert(array.markers.end(), markers.begin(), markers.end());
+      }
     }
+    publisher.publish(array);
+  } catch (const std::exception& error) {
+    ROS_ERROR("~%s subscriber: %s", names::kBodyMarkersTopic, error.what());
   }
-  publisher.publish(array);
 }
 
 }  // namespace rigid_body_sim::node

@@ -59,6 +59,7 @@ void SimNode::FillPeriodicLocked(Outbox* outbox) {
       states.twist.push_back(TwistToMsg(state.linear_velocity, state.angular_velocity));
     }
   }
+  states.frozen.assign(frozen_models_.begin(), frozen_models_.end());
   // tf2 drops a transform whose stamp it already holds, so tf and contacts
   // go out only when sim time moved.
   if (sim_time == last_periodic_time_) return;

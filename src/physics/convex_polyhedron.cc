@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace rigid_body_sim::physics {
@@ -86,8 +88,12 @@ TriangleMesh ConvexPolyhedron::Triangulate() const {
 // The face normal to axis a uses the cyclic axes b = a+1, c = a+2; the
 // corner order (0,0), (1,0), (1,1), (0,1) in (b, c) runs counter-clockwise
 // seen from +a since e_b x e_c = e_a, and reversed for the - face.
-ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size) {
-  assert(size.allFinite() && (size.array() > 0.0).all());
+Result<ConvexPolyhedron> TryMakeBoxPolyhedron(const Vec3& size) {
+  if (!size.allFinite() || !(size.array() > 0.0).all()) {
+    return Result<ConvexPolyhedron>::Error("box size (" + FormatNumber(size.x()) + ", " +
+                                           FormatNumber(size.y()) + ", " + FormatNumber(size.z()) +
+                                           ") m must be finite and positive");
+  }
   std::vector<Vec3> vertices(8);
   for (int i = 0; i < 8; ++i) {
     for (int k = 0; k < 3; ++k) vertices[i][k] = ((i >> k) & 1 ? 0.5 : -0.5) * size[k];
@@ -103,7 +109,12 @@ ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size) {
       faces.push_back(face);
     }
   }
-  Result<ConvexPolyhedron> box = MakeConvexPolyhedron(vertices, faces);
+  return MakeConvexPolyhedron(vertices, faces);
+}
+
+ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size) {
+  assert(size.allFinite() && (size.array() > 0.0).all());
+  Result<ConvexPolyhedron> box = TryMakeBoxPolyhedron(size);
   assert(box.ok());
   return std::move(box).value();
 }
@@ -111,10 +122,16 @@ ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size) {
 // Bottom ring i at z = -l/2, top ring segments + i at z = +l/2, angle
 // 2 pi i / segments. Side quad i (b_i, b_i+1, t_i+1, t_i) is counter-clockwise
 // from outside; the top cap runs with increasing angle, the bottom against.
-ConvexPolyhedron MakeCylinderPolyhedron(double radius, double length, int segments) {
-  assert(std::isfinite(radius) && radius > 0.0);
-  assert(std::isfinite(length) && length > 0.0);
-  assert(segments >= 3);
+Result<ConvexPolyhedron> TryMakeCylinderPolyhedron(double radius, double length, int segments) {
+  if (!std::isfinite(radius) || !(radius > 0.0) || !std::isfinite(length) || !(length > 0.0)) {
+    return Result<ConvexPolyhedron>::Error("cylinder radius " + FormatNumber(radius) +
+                                           " m and length " + FormatNumber(length) +
+                                           " m must be finite and positive");
+  }
+  if (segments < 3) {
+    return Result<ConvexPolyhedron>::Error("cylinder segments " + std::to_string(segments) +
+                                           " must be >= 3");
+  }
   std::vector<Vec3> vertices(2 * segments);
   for (int i = 0; i < segments; ++i) {
     const double angle = 2.0 * kPi * i / segments;
@@ -134,7 +151,14 @@ ConvexPolyhedron MakeCylinderPolyhedron(double radius, double length, int segmen
   }
   faces.push_back(top);
   faces.push_back(bottom);
-  Result<ConvexPolyhedron> cylinder = MakeConvexPolyhedron(vertices, faces);
+  return MakeConvexPolyhedron(vertices, faces);
+}
+
+ConvexPolyhedron MakeCylinderPolyhedron(double radius, double length, int segments) {
+  assert(std::isfinite(radius) && radius > 0.0);
+  assert(std::isfinite(length) && length > 0.0);
+  assert(segments >= 3);
+  Result<ConvexPolyhedron> cylinder = TryMakeCylinderPolyhedron(radius, length, segments);
   assert(cylinder.ok());
   return std::move(cylinder).value();
 }

@@ -304,6 +304,7 @@ void WorldImpl::Step() {
   };
   StepProfile& profile = last_step_profile_;
 
+  GuardBeforeStep(dt);
   UpdateBroadPhase(dt);
   profile.broad_phase_ms = lap();
   UpdateNarrowPhase(dt);
@@ -314,6 +315,7 @@ void WorldImpl::Step() {
   profile.solver_ms = lap();
   IntegrateBodies(dt);
   profile.integrator_ms = lap();
+  GuardAfterStep();
 
   profile.solver_points = 0;
   for (const SolverManifold& manifold : solver_.manifolds()) {

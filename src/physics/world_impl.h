@@ -99,6 +99,12 @@ class WorldImpl {
   void UpdateSleep(double dt);
   bool UpdateSpeedingUp(double dt, Body* body) const;
   void DisableNonFiniteBodies();
+  // The step guard (step_guard.cc), around stages 1-5: bodies whose state
+  // or pending force would overflow a step are frozen before it, bodies
+  // whose state is not finite after it go back to their pose at its start.
+  void GuardBeforeStep(double dt);
+  void GuardAfterStep();
+  void FreezeBody(std::uint32_t index, const Pose& world_from_principal);
   // `pairs` are the touching pairs, one per solver manifold.
   void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt);
   ContactReport MakeReport(const ShapePairContact& pair, int point,
@@ -127,6 +133,7 @@ class WorldImpl {
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
   std::vector<BodyId> non_finite_bodies_;
+  std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
   StepProfile last_step_profile_;
 };
 

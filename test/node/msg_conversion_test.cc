@@ -38,19 +38,35 @@ TEST(MsgConversionTest, NonUnitQuaternionIsNormalised) {
 TEST(MsgConversionTest, ZeroQuaternionAndNonFiniteValuesAreRefusedByField) {
   const auto zero = PoseFromMsg(MsgPose(0, 0, 0, 0, 0, 0, 0), "pose");
   ASSERT_FALSE(zero.ok());
-  EXPECT_EQ(zero.message(), "pose.orientation is a zero quaternion");
+  EXPECT_EQ(zero.message(),
+            "pose.orientation (w, x, y, z) = (0, 0, 0, 0) is a zero quaternion: norm 0 outside "
+            "the allowed range [1e-09, 1e+09]");
   const auto nan = PoseFromMsg(MsgPose(0, std::nan(""), 0, 1, 0, 0, 0), "pose");
   ASSERT_FALSE(nan.ok());
-  EXPECT_EQ(nan.message(), "pose.position is not finite");
+  EXPECT_EQ(nan.message(), "pose.position [0, nan, 0] is not finite");
   const auto inf =
       PoseFromMsg(MsgPose(0, 0, 0, std::numeric_limits<double>::infinity(), 0, 0, 0), "pose");
   ASSERT_FALSE(inf.ok());
-  EXPECT_EQ(inf.message(), "pose.orientation is not finite");
+  EXPECT_EQ(inf.message(), "pose.orientation (w, x, y, z) = (inf, 0, 0, 0) is not finite");
   geometry_msgs::Twist twist;
   twist.angular.y = std::nan("");
   const auto state = FrameStateFromMsg(MsgPose(0, 0, 0, 1, 0, 0, 0), twist);
   ASSERT_FALSE(state.ok());
-  EXPECT_EQ(state.message(), "twist.angular is not finite");
+  EXPECT_EQ(state.message(), "twist.angular [0, nan, 0] is not finite");
+}
+
+// 1e300 on every component: norm() overflows to infinity and normalising
+// gave a zero quaternion ("norm 0.000000"); the stable norm is 2e300,
+// refused by name, and 1e200s are normalised exactly.
+TEST(MsgConversionTest, HugeQuaternionIsRefusedWithItsNorm) {
+  const auto huge = PoseFromMsg(MsgPose(0, 0, 0, 1e300, 1e300, 1e300, 1e300), "pose");
+  ASSERT_FALSE(huge.ok());
+  EXPECT_EQ(huge.message(),
+            "pose.orientation (w, x, y, z) = (1e+300, 1e+300, 1e+300, 1e+300) has norm 2e+300 "
+            "outside the allowed range [1e-09, 1e+09]");
+  const auto large = PoseFromMsg(MsgPose(0, 0, 0, 0, 0, 0, 1e8), "pose");
+  ASSERT_TRUE(large.ok()) << large.message();
+  EXPECT_EQ(large->rotation.z(), 1.0);
 }
 
 TEST(MsgConversionTest, PoseAndTwistRoundTrip) {

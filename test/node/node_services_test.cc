@@ -364,7 +364,7 @@ TEST_F(NodeServicesTest, BadInputIsRefusedAndChangesNothing) {
   missing.pose = MakePose(0, 0, 30);
   expect_refused(client_.Spawn(missing), "/nonexistent/dir/missing.urdf");
   expect_refused(client_.SpawnUrdf("nan_pose", box, MakePose(0, std::nan(""), 30)),
-                 "pose.position is not finite");
+                 "pose.position [0, nan, 30] is not finite");
   expect_refused(client_.SpawnUrdf("zero_quat", box, MakePose(0, 0, 30, 0, 0, 0, 0)),
                  "zero quaternion");
 

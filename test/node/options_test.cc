@@ -16,7 +16,7 @@ TEST(OptionsTest, BadValuesAreNamed) {
   NodeOptions options;
   options.world.time_step = -0.01;
   EXPECT_EQ(ValidateNodeOptions(options).message(),
-            "~time_step -0.01 s must be positive and finite");
+            "~time_step -0.01 s is outside the allowed range [1e-05, 0.1] s");
   options = NodeOptions();
   options.real_time_factor = -1.0;
   EXPECT_NE(ValidateNodeOptions(options).message().find("~real_time_factor"), std::string::npos);

@@ -144,6 +144,10 @@ bool SimClient::SetPaused(bool paused) {
   return Call<std_srvs::SetBool>("set_paused", request).success;
 }
 
+std_srvs::Trigger::Response SimClient::CancelStep() {
+  return Call<std_srvs::Trigger>("cancel_step", {});
+}
+
 bool SimClient::Reset() { return Call<std_srvs::Trigger>("reset", {}).success; }
 
 rigid_body_sim::GetPhysics::Response SimClient::GetPhysics() {

@@ -11,6 +11,7 @@
 
 #include <geometry_msgs/Pose.h>
 #include <ros/ros.h>
+#include <std_srvs/Trigger.h>
 
 #include "rigid_body_sim/ApplyWrench.h"
 #include "rigid_body_sim/Contacts.h"
@@ -58,6 +59,7 @@ class SimClient {
       const rigid_body_sim::ApplyWrench::Request& request);
   rigid_body_sim::Step::Response Step(std::uint32_t steps);
   bool SetPaused(bool paused);
+  std_srvs::Trigger::Response CancelStep();
   bool Reset();
   rigid_body_sim::GetPhysics::Response GetPhysics();
   rigid_body_sim::SetPhysics::Response SetPhysics(const rigid_body_sim::SetPhysics::Request& r);

@@ -2,6 +2,7 @@
 #ifndef RIGID_BODY_SIM_IO_MESH_LOADER_H_
 #define RIGID_BODY_SIM_IO_MESH_LOADER_H_
 
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -28,9 +29,13 @@ physics::Result<std::string> ResolveFileUri(const std::string& uri);
 // no closedness is required.
 // Fails, naming the file, when the file is missing or unreadable, its format
 // is unsupported, it has no triangles, or a vertex is not finite.
+// Files that are not regular (/dev/zero, a FIFO) or larger than
+// `max_file_bytes` are refused before assimp opens them.
 physics::Result<physics::TriangleMesh> LoadMesh(const std::string& uri,
                                                 const physics::Vec3& scale = physics::Vec3::Ones(),
-                                                const UriResolver& resolver = ResolveFileUri);
+                                                const UriResolver& resolver = ResolveFileUri,
+                                                std::uintmax_t max_file_bytes = std::uintmax_t{256}
+                                                                                << 20);
 
 }  // namespace rigid_body_sim::io
 

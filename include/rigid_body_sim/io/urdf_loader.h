@@ -3,6 +3,9 @@
 #ifndef RIGID_BODY_SIM_IO_URDF_LOADER_H_
 #define RIGID_BODY_SIM_IO_URDF_LOADER_H_
 
+#include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,11 +18,32 @@
 
 namespace rigid_body_sim::io {
 
+// Limits on collision geometry: every size of a box, cylinder, sphere or
+// mesh hull (m), and a shape's largest size over its smallest. Outside them
+// the convex-polyhedron builder degenerates or the solver's scales part by
+// more than a double can carry.
+inline constexpr double kMinShapeSize = 1e-4;
+inline constexpr double kMaxShapeSize = 1e4;
+inline constexpr double kMaxShapeAspectRatio = 1e3;
+
+// Builds the hull of the mesh file at a resolved local `path`, scaled per
+// axis; e.g. CachedMeshHull (mesh_process.h), out of process.
+using MeshHullLoader =
+    std::function<physics::Result<std::shared_ptr<const physics::ConvexPolyhedron>>(
+        const std::string& path, const physics::Vec3& scale, const HullOptions& hull)>;
+
 struct UrdfLoadOptions {
   // kg/m^3: density of links without <inertial>, whose mass properties are
   // computed from their collision geometry.
   double default_density = 1000.0;
   HullOptions hull;            // for <mesh> collisions
+  int max_links = 1000;        // count, >= 1: a model with more <link>s is refused
+  // Bytes; a URDF or mesh file larger than this, or not a regular file
+  // (/dev/zero, a FIFO), is refused before it is read.
+  std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;
+  // When set, mesh hulls come from it; when empty, meshes are imported and
+  // hulled in this process (LoadMesh, ComputeConvexHull).
+  MeshHullLoader mesh_hull_loader;
   // Maps package:// and file:// URIs of meshes to local paths. When empty,
   // ResolveFileUri is used, so package:// URIs are an error.
   UriResolver resolver;
@@ -54,7 +78,8 @@ struct LoadedModel {
 
 // Parses a URDF document. Fails, naming the element, on malformed XML,
 // unsupported or movable joints, invalid <inertial>, unreadable or degenerate
-// meshes, or a model without collision geometry. Relative mesh paths are
+// meshes, sizes outside the limits above, more links than
+// options.max_links, or a model without collision geometry. Relative mesh paths are
 // taken relative to the working directory.
 physics::Result<LoadedModel> LoadUrdfString(const std::string& xml,
                                             const UrdfLoadOptions& options = {});

@@ -33,8 +33,9 @@ physics::Result<physics::Vec3> VectorFromMsg(const geometry_msgs::Vector3& msg,
                                              const std::string& field);
 physics::Result<physics::Vec3> PointFromMsg(const geometry_msgs::Point& msg,
                                             const std::string& field);
-// Fails on a non-finite position or orientation, or a quaternion of norm
-// below 1e-9 (no rotation); any other quaternion is normalised.
+// Fails on a non-finite position or orientation, or a quaternion whose norm
+// is outside [kMinQuaternionNorm, kMaxQuaternionNorm] (request_validation.h);
+// any other quaternion is normalised.
 physics::Result<physics::Pose> PoseFromMsg(const geometry_msgs::Pose& msg,
                                            const std::string& field);
 physics::Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
@@ -53,7 +54,7 @@ geometry_msgs::TransformStamped TransformToMsg(const physics::Pose& parent_from_
                                                const std::string& parent_frame,
                                                const std::string& child_frame,
                                                const ros::Time& stamp);
-// Sim time (s) as a ROS time stamp.
+// Sim time (s) as a ROS time stamp, clamped to [0, ros::TIME_MAX]; never throws.
 ros::Time SimTimeToRos(double sim_time);
 
 rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,

@@ -18,6 +18,7 @@ inline constexpr char kSetStateService[] = "set_state";
 inline constexpr char kApplyWrenchService[] = "apply_wrench";
 inline constexpr char kGetPhysicsService[] = "get_physics";
 inline constexpr char kSetPhysicsService[] = "set_physics";
+inline constexpr char kCancelStepService[] = "cancel_step";
 
 // Topics (~).
 inline constexpr char kContactsTopic[] = "contacts";

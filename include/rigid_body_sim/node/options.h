@@ -10,6 +10,7 @@
 #include <ros/node_handle.h>
 
 #include "rigid_body_sim/node/model_registry.h"
+#include "rigid_body_sim/node/request_validation.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/world.h"
 
@@ -45,6 +46,16 @@ struct NodeOptions {
   double status_period = 5.0;  // ~status_period: s of real time between INFO status lines, > 0
   // ~contact_force_scale: m of contact-marker arrow per N of normal force, > 0
   double contact_force_scale = 0.02;
+  // ~max_position (m, 1e6), ~max_linear_speed (m/s, 1e4),
+  // ~max_angular_speed (rad/s, 1e4), ~max_force (N, 1e9), ~max_torque (N m,
+  // 1e9), ~max_wrench_duration (s, 3600), ~max_step_count (count, 100000):
+  // requests beyond them are refused (request_validation.h).
+  RequestLimits limits;
+  int max_links_per_model = 1000;  // ~max_links_per_model: count, >= 1
+  int max_file_bytes = 256 << 20;  // ~max_file_bytes: URDF and mesh files, bytes, >= 1
+  // Limits of the mesh helper process (io/mesh_process.h).
+  int mesh_memory_limit = 1 << 30;  // ~mesh_memory_limit: bytes of address space, >= 2^24
+  double mesh_cpu_limit = 10.0;     // ~mesh_cpu_limit: s of CPU, (0, 3600]
   // ~models: spawned at start-up, in order; each entry has the fields of
   // Spawn (name, urdf, urdf_path, is_static, friction, restitution), pose:
   // [x, y, z, roll, pitch, yaw] (m, rad; default all 0) and twist:

@@ -10,6 +10,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -101,11 +102,20 @@ class SimNode {
                     rigid_body_sim::GetPhysics::Response& response);
   bool OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
                     rigid_body_sim::SetPhysics::Response& response);
+  bool OnCancelStep(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  // Advertises `method` as service `name`, answering success = false with
+  // the reason when it throws (or failing the call for a response without
+  // success), so that no exception leaves a callback.
+  template <typename Request, typename Response>
+  ros::ServiceServer Advertise(const char* name,
+                               bool (SimNode::*method)(Request& request, Response& response));
   void OnBodyMarkersSubscriber(const ros::SingleSubscriberPublisher& publisher);
 
   void StepLoop();
   // The callers of these hold the mutex.
   void StepLocked();
+  // Logs and records the bodies the last step froze (World::non_finite_bodies).
+  void ReportFrozenLocked();
   void ReanchorLocked();
   FrameState RootStateLocked(const Model& model) const;
   // The periodic messages; tf, contacts and the clock only when sim time
@@ -138,7 +148,12 @@ class SimNode {
   std::optional<physics::BodyId> ground_;
   std::vector<ActiveWrench> wrenches_;
   std::map<std::string, std::vector<visualization_msgs::Marker>> body_markers_;  // by model
+  std::set<std::string> frozen_models_;  // frozen by the step guard, until set_state or reset
   bool paused_ = false;
+  // A ~step call runs in chunks; between them ~cancel_step can stop it.
+  std::mutex step_service_mutex_;  // one ~step call at a time
+  bool step_in_progress_ = false;
+  std::string cancel_step_;  // the service that stops the ~step call in progress, if any
   bool shutdown_ = false;
   double real_time_factor_ = 1.0;
   double last_periodic_time_ = -1.0;  // sim time of the last tf and contacts

@@ -53,6 +53,11 @@ Result<ConvexPolyhedron> MakeConvexPolyhedron(const std::vector<Vec3>& vertices,
 ConvexPolyhedron MakeBoxPolyhedron(const Vec3& size);  // full edge lengths, m, centred
 // Prism with `segments` sides inscribed in the cylinder, axis z, centred.
 ConvexPolyhedron MakeCylinderPolyhedron(double radius, double length, int segments);
+// As the two above, for sizes from outside (asserts are off in Release):
+// fail with a message naming the value instead, e.g. for a size that is not
+// finite and positive, or proportions so extreme that a face degenerates.
+Result<ConvexPolyhedron> TryMakeBoxPolyhedron(const Vec3& size);
+Result<ConvexPolyhedron> TryMakeCylinderPolyhedron(double radius, double length, int segments);
 
 MassProperties PolyhedronMassProperties(double density, const ConvexPolyhedron& polyhedron);
 

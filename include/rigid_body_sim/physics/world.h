@@ -67,9 +67,12 @@ class World {
   // caches, warm starts, sleep timers); bodies keep their state.
   void Restart();
 
-  // Bodies whose state became non-finite in the last step (e.g. forces that
-  // overflowed). They are taken out of the simulation, so no NaN reaches
-  // their neighbours, until SetState gives them a finite state again.
+  // Bodies frozen in the last step, each listed once: a state that became
+  // non-finite (e.g. forces that overflowed), or a position, velocity or
+  // pending force beyond 1e100 in SI units, where a step's products could
+  // overflow. A frozen body is held at its last finite pose with zero
+  // velocity, out of the simulation (no contacts), so no NaN reaches its
+  // neighbours, until SetState gives it a state again.
   const std::vector<BodyId>& non_finite_bodies() const;
 
   // The contact points of the last step.

@@ -1,0 +1,59 @@
+// Mesh hulls built out of process: assimp and qhull run on untrusted files in
+// a helper executable (rigid_body_sim_mesh_helper) started per mesh with
+// posix_spawn, under limits on address space, CPU time and input size. An
+// abort, an exhausted memory limit or a timeout in the helper is an error
+// message here; whatever the importer leaks or crashes on stays in the
+// child. The caller's process keeps a cache by path, scale, size and
+// modification time, so a repeated mesh costs no process. ROS-free.
+#ifndef RIGID_BODY_SIM_IO_MESH_PROCESS_H_
+#define RIGID_BODY_SIM_IO_MESH_PROCESS_H_
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rigid_body_sim/io/convex_hull.h"
+#include "rigid_body_sim/physics/convex_polyhedron.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::io {
+
+struct MeshProcessLimits {
+  std::string helper_path;                                  // the helper executable
+  std::uint64_t memory_bytes = std::uint64_t{1} << 30;      // RLIMIT_AS of the helper
+  double cpu_seconds = 10.0;                                // RLIMIT_CPU; wall time 2x + 1 s
+  std::uint64_t max_file_bytes = std::uint64_t{256} << 20;  // larger files are not opened
+};
+
+// The hull of the mesh file at `path` (a local path, already resolved),
+// scaled per axis, built by the helper. Fails naming the file on a file that
+// is missing, not regular or too large (checked before any process starts),
+// on the helper's refusal (its message), or on its death (the signal or the
+// limit it hit).
+physics::Result<physics::ConvexPolyhedron> LoadMeshHullOutOfProcess(
+    const std::string& path, const physics::Vec3& scale, const HullOptions& hull,
+    const MeshProcessLimits& limits);
+
+// As above, through a process-wide cache keyed by path, scale, hull options,
+// file size and modification time: a cached mesh starts no process. Failures
+// are not cached. Thread-safe.
+physics::Result<std::shared_ptr<const physics::ConvexPolyhedron>> CachedMeshHull(
+    const std::string& path, const physics::Vec3& scale, const HullOptions& hull,
+    const MeshProcessLimits& limits);
+
+// The helper's side, shared with it and with the fuzzer: the reply that
+// carries a hull through the pipe, and its parsing. The text holds
+// hexadecimal floats, so the parent gets the child's doubles exactly.
+std::string FormatHullReply(const physics::ConvexPolyhedron& hull);
+std::string FormatErrorReply(const std::string& message);
+// Parses a reply of at most `max_vertices` vertices into a polyhedron
+// (MakeConvexPolyhedron checks it is closed and convex), or returns the
+// helper's error message as the error.
+physics::Result<physics::ConvexPolyhedron> ParseHullReply(const std::string& reply,
+                                                          int max_vertices);
+
+}  // namespace rigid_body_sim::io
+
+#endif  // RIGID_BODY_SIM_IO_MESH_PROCESS_H_

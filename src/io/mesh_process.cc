@@ -1,0 +1,322 @@
+#include "rigid_body_sim/io/mesh_process.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+extern char** environ;
+
+namespace rigid_body_sim::io {
+namespace {
+
+using physics::ConvexPolyhedron;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+// A hull of 1e5 vertices is about 10 MB of text; more is not a hull.
+constexpr std::size_t kMaxReplyBytes = std::size_t{64} << 20;
+// Cached hulls at most; past it the cache starts afresh.
+constexpr std::size_t kMaxCachedHulls = 1024;
+
+std::string Quoted(const std::string& text) { return "'" + text + "'"; }
+
+std::string HexFloat(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%a", value);
+  return buffer;
+}
+
+// The file is regular and small enough; checked before anything opens it.
+Result<struct stat> CheckFile(const std::string& path, std::uint64_t max_file_bytes) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) {
+    return Result<struct stat>::Error("mesh file " + Quoted(path) +
+                                      " cannot be read: " + std::strerror(errno));
+  }
+  if (!S_ISREG(info.st_mode)) {
+    return Result<struct stat>::Error("mesh file " + Quoted(path) + " is not a regular file");
+  }
+  if (static_cast<std::uint64_t>(info.st_size) > max_file_bytes) {
+    return Result<struct stat>::Error("mesh file " + Quoted(path) + " size " +
+                                      std::to_string(info.st_size) + " bytes is above the limit " +
+                                      std::to_string(max_file_bytes));
+  }
+  return info;
+}
+
+std::string DescribeLimits(const MeshProcessLimits& limits) {
+  std::ostringstream out;
+  out << "limits " << limits.memory_bytes << " bytes of memory, " << limits.cpu_seconds
+      << " s of CPU";
+  return out.str();
+}
+
+// Why the helper ended, from its wait status.
+std::string DescribeDeath(int status, bool timed_out, const MeshProcessLimits& limits) {
+  if (timed_out) {
+    return "took longer than " + physics::FormatNumber(2.0 * limits.cpu_seconds + 1.0) +
+           " s and was killed (" + DescribeLimits(limits) + ")";
+  }
+  if (WIFSIGNALED(status)) {
+    const int signal = WTERMSIG(status);
+    std::string what =
+        "was killed by signal " + std::to_string(signal) + " (" + strsignal(signal) + ")";
+    if (signal == SIGXCPU || signal == SIGKILL) what += ": it ran out of CPU time";
+    if (signal == SIGABRT) what += ": the importer aborted";
+    if (signal == SIGSEGV) what += ": the importer crashed";
+    return what + " (" + DescribeLimits(limits) + ")";
+  }
+  return "exited with status " + std::to_string(WEXITSTATUS(status)) + " without a hull (" +
+         DescribeLimits(limits) + ")";
+}
+
+// Runs the helper and returns its wait status and its standard output.
+struct HelperRun {
+  int status = 0;
+  bool timed_out = false;
+  bool oversized = false;  // the reply passed kMaxReplyBytes
+  std::string reply;
+};
+
+Result<HelperRun> RunHelper(const std::vector<std::string>& arguments,
+                            const MeshProcessLimits& limits) {
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
+    return Result<HelperRun>::Error(std::string("mesh helper: pipe: ") + std::strerror(errno));
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  // The node's sockets and files are none of the helper's business.
+  posix_spawn_file_actions_addclosefrom_np(&actions, 3);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t signals;
+  sigemptyset(&signals);
+  posix_spawnattr_setsigmask(&attributes, &signals);
+  sigfillset(&signals);
+  posix_spawnattr_setsigdefault(&attributes, &signals);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+
+  std::vector<char*> argv;
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawned =
+      posix_spawn(&pid, limits.helper_path.c_str(), &actions, &attributes, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  ::close(pipe_fds[1]);
+  if (spawned != 0) {
+    ::close(pipe_fds[0]);
+    return Result<HelperRun>::Error("mesh helper " + Quoted(limits.helper_path) +
+                                    " cannot be started: " + std::strerror(spawned));
+  }
+
+  HelperRun run;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration<double>(2.0 * limits.cpu_seconds + 1.0);
+  char buffer[65536];
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0 || run.reply.size() > kMaxReplyBytes) {
+      ::kill(pid, SIGKILL);
+      run.timed_out = left.count() <= 0;
+      run.oversized = !run.timed_out;
+      break;
+    }
+    pollfd readable{pipe_fds[0], POLLIN, 0};
+    const int ready = ::poll(&readable, 1, static_cast<int>(left.count()));
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0) continue;
+    const ssize_t count = ::read(pipe_fds[0], buffer, sizeof(buffer));
+    if (count < 0 && errno == EINTR) continue;
+    if (count <= 0) break;  // end of file: the helper is done
+    run.reply.append(buffer, static_cast<std::size_t>(count));
+  }
+  ::close(pipe_fds[0]);
+  while (::waitpid(pid, &run.status, 0) < 0 && errno == EINTR) {
+  }
+  return run;
+}
+
+}  // namespace
+
+std::string FormatHullReply(const ConvexPolyhedron& hull) {
+  std::string reply = "hull " + std::to_string(hull.vertices.size()) + " " +
+                      std::to_string(hull.faces.size()) + "\n";
+  for (const Vec3& vertex : hull.vertices) {
+    reply += "v " + HexFloat(vertex.x()) + " " + HexFloat(vertex.y()) + " " + HexFloat(vertex.z()) +
+             "\n";
+  }
+  for (int face = 0; face < static_cast<int>(hull.faces.size()); ++face) {
+    const std::vector<int> loop = hull.FaceVertices(face);
+    reply += "f " + std::to_string(loop.size());
+    for (const int vertex : loop) reply += " " + std::to_string(vertex);
+    reply += "\n";
+  }
+  return reply;
+}
+
+std::string FormatErrorReply(const std::string& message) {
+  std::string line = message;
+  for (char& c : line) {
+    if (c == '\n') c = ' ';
+  }
+  return "error " + line + "\n";
+}
+
+Result<ConvexPolyhedron> ParseHullReply(const std::string& reply, int max_vertices) {
+  const auto fail = [](const std::string& why) {
+    return Result<ConvexPolyhedron>::Error("mesh helper reply: " + why);
+  };
+  if (reply.rfind("error ", 0) == 0) {
+    const std::size_t end = reply.find('\n');
+    return Result<ConvexPolyhedron>::Error(
+        reply.substr(6, end == std::string::npos ? end : end - 6));
+  }
+  std::istringstream in(reply);
+  std::string word;
+  long vertex_count = 0;
+  long face_count = 0;
+  if (!(in >> word >> vertex_count >> face_count) || word != "hull") {
+    return fail("no 'hull <vertices> <faces>' header");
+  }
+  // A convex polyhedron has F <= 2V - 4 faces.
+  if (vertex_count < 4 || vertex_count > max_vertices || face_count < 4 ||
+      face_count > 2 * vertex_count - 4) {
+    return fail(std::to_string(vertex_count) + " vertices and " + std::to_string(face_count) +
+                " faces are outside [4, " + std::to_string(max_vertices) + "] and [4, 2V - 4]");
+  }
+  std::vector<Vec3> vertices(static_cast<std::size_t>(vertex_count));
+  for (Vec3& vertex : vertices) {
+    std::string coordinates[3];
+    if (!(in >> word >> coordinates[0] >> coordinates[1] >> coordinates[2]) || word != "v") {
+      return fail("a vertex line is malformed");
+    }
+    for (int k = 0; k < 3; ++k) {
+      char* end = nullptr;
+      vertex[k] = std::strtod(coordinates[k].c_str(), &end);
+      if (end == coordinates[k].c_str() || *end != '\0' || !std::isfinite(vertex[k])) {
+        return fail("vertex coordinate " + Quoted(coordinates[k]) + " is not a finite number");
+      }
+    }
+  }
+  std::vector<std::vector<int>> faces(static_cast<std::size_t>(face_count));
+  for (std::vector<int>& face : faces) {
+    long size = 0;
+    if (!(in >> word >> size) || word != "f" || size < 3 || size > vertex_count) {
+      return fail("a face line is malformed");
+    }
+    face.resize(static_cast<std::size_t>(size));
+    for (int& index : face) {
+      long value = -1;
+      if (!(in >> value) || value < 0 || value >= vertex_count) {
+        return fail("a face has a vertex index outside [0, " + std::to_string(vertex_count) + ")");
+      }
+      index = static_cast<int>(value);
+    }
+  }
+  return physics::MakeConvexPolyhedron(vertices, faces);
+}
+
+Result<ConvexPolyhedron> LoadMeshHullOutOfProcess(const std::string& path, const Vec3& scale,
+                                                  const HullOptions& hull,
+                                                  const MeshProcessLimits& limits) {
+  if (!scale.allFinite() || (scale.array() == 0.0).any()) {
+    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) +
+                                           ": scale must be finite and non-zero on every axis");
+  }
+  if (Result<struct stat> file = CheckFile(path, limits.max_file_bytes); !file.ok()) {
+    return file.status();
+  }
+  const std::vector<std::string> arguments = {limits.helper_path,
+                                              path,
+                                              HexFloat(scale.x()),
+                                              HexFloat(scale.y()),
+                                              HexFloat(scale.z()),
+                                              std::to_string(hull.max_vertices),
+                                              HexFloat(hull.degenerate_tolerance),
+                                              std::to_string(limits.memory_bytes),
+                                              HexFloat(limits.cpu_seconds),
+                                              std::to_string(limits.max_file_bytes)};
+  Result<HelperRun> run = RunHelper(arguments, limits);
+  if (!run.ok()) return run.status();
+  if (run->oversized) {
+    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) + ": the mesh helper's reply " +
+                                           "passed " + std::to_string(kMaxReplyBytes) +
+                                           " bytes and it was killed");
+  }
+  const bool exited = WIFEXITED(run->status);
+  if (!run->timed_out && exited && run->reply.rfind("error ", 0) == 0) {
+    // The helper's own refusal. An allocation that failed at the memory
+    // limit can look like a malformed file to the importer, so the limits
+    // go with the reason.
+    return Result<ConvexPolyhedron>::Error(ParseHullReply(run->reply, hull.max_vertices).message() +
+                                           " (in the mesh helper, " + DescribeLimits(limits) + ")");
+  }
+  if (run->timed_out || !exited || WEXITSTATUS(run->status) != 0) {
+    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) + ": the mesh helper " +
+                                           DescribeDeath(run->status, run->timed_out, limits));
+  }
+  Result<ConvexPolyhedron> parsed = ParseHullReply(run->reply, hull.max_vertices);
+  if (!parsed.ok()) {
+    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) + ": " + parsed.message());
+  }
+  return parsed;
+}
+
+Result<std::shared_ptr<const ConvexPolyhedron>> CachedMeshHull(const std::string& path,
+                                                               const Vec3& scale,
+                                                               const HullOptions& hull,
+                                                               const MeshProcessLimits& limits) {
+  using Key = std::tuple<std::string, double, double, double, int, double, std::int64_t,
+                         std::int64_t, std::int64_t>;
+  static std::mutex mutex;
+  static std::map<Key, std::shared_ptr<const ConvexPolyhedron>> cache;
+  Result<struct stat> file = CheckFile(path, limits.max_file_bytes);
+  if (!file.ok()) return file.status();
+  const Key key{path,
+                scale.x(),
+                scale.y(),
+                scale.z(),
+                hull.max_vertices,
+                hull.degenerate_tolerance,
+                static_cast<std::int64_t>(file->st_size),
+                static_cast<std::int64_t>(file->st_mtim.tv_sec),
+                static_cast<std::int64_t>(file->st_mtim.tv_nsec)};
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto found = cache.find(key);
+    if (found != cache.end()) return found->second;
+  }
+  Result<ConvexPolyhedron> built = LoadMeshHullOutOfProcess(path, scale, hull, limits);
+  if (!built.ok()) return built.status();
+  auto shared = std::make_shared<const ConvexPolyhedron>(std::move(built).value());
+  std::lock_guard<std::mutex> lock(mutex);
+  if (cache.size() >= kMaxCachedHulls) cache.clear();
+  cache.emplace(key, shared);
+  return std::shared_ptr<const ConvexPolyhedron>(shared);
+}
+
+}  // namespace rigid_body_sim::io

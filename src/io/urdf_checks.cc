@@ -1,0 +1,209 @@
+#include "io/urdf_checks.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace rigid_body_sim::io {
+namespace {
+
+using physics::FormatNumber;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+std::string Quoted(const std::string& text) { return "'" + text + "'"; }
+
+std::string Range(double low, double high) {
+  return "[" + FormatNumber(low) + ", " + FormatNumber(high) + "]";
+}
+
+// The whitespace-separated numbers of attribute `name` of `element`;
+// `where` names the element. A missing attribute gives no numbers.
+Result<std::vector<double>> Numbers(const TiXmlElement& element, const char* name,
+                                    const std::string& where) {
+  const char* text = element.Attribute(name);
+  std::vector<double> numbers;
+  if (text == nullptr) return numbers;
+  const char* cursor = text;
+  for (;;) {
+    while (*cursor == ' ' || *cursor == '\t' || *cursor == '\n' || *cursor == '\r') ++cursor;
+    if (*cursor == '\0') break;
+    char* end = nullptr;
+    errno = 0;
+    const double value = std::strtod(cursor, &end);
+    const std::string field = where + " " + name + "=" + Quoted(text);
+    if (end == cursor) return Result<std::vector<double>>::Error(field + " is not a number");
+    if (!std::isfinite(value) || errno == ERANGE) {
+      return Result<std::vector<double>>::Error(field + " is not a finite number");
+    }
+    numbers.push_back(value);
+    cursor = end;
+  }
+  return numbers;
+}
+
+// Attribute `name` as exactly `count` numbers within [low, high]; absent is
+// fine when `required` is false.
+Result<std::vector<double>> NumbersIn(const TiXmlElement& element, const char* name,
+                                      const std::string& where, std::size_t count, double low,
+                                      double high, bool required) {
+  Result<std::vector<double>> numbers = Numbers(element, name, where);
+  if (!numbers.ok()) return numbers;
+  const std::string field = where + " " + name;
+  if (numbers->empty() && !required) return numbers;
+  if (numbers->size() != count) {
+    return Result<std::vector<double>>::Error(field + " must have " + std::to_string(count) +
+                                              " number" + (count == 1 ? "" : "s") + ", has " +
+                                              std::to_string(numbers->size()));
+  }
+  for (const double value : *numbers) {
+    if (!(value >= low && value <= high)) {
+      return Result<std::vector<double>>::Error(
+          field + " " + FormatNumber(value) + " is outside the allowed range " + Range(low, high));
+    }
+  }
+  return numbers;
+}
+
+// <origin xyz rpy>: xyz within kMaxShapeSize of the parent frame, rpy finite.
+Status CheckOrigin(const TiXmlElement& parent, const std::string& where) {
+  const TiXmlElement* origin = parent.FirstChildElement("origin");
+  if (origin == nullptr) return Status::Ok();
+  const std::string at = where + " <origin>";
+  Result<std::vector<double>> xyz =
+      NumbersIn(*origin, "xyz", at, 3, -kMaxShapeSize, kMaxShapeSize, false);
+  if (!xyz.ok()) return xyz.status();
+  Result<std::vector<double>> rpy = NumbersIn(*origin, "rpy", at, 3, -1e6, 1e6, false);
+  return rpy.status();
+}
+
+Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
+  for (const TiXmlElement* shape = geometry.FirstChildElement(); shape != nullptr;
+       shape = shape->NextSiblingElement()) {
+    const std::string kind = shape->ValueStr();
+    const std::string at = where + " <" + kind + ">";
+    if (kind == "box") {
+      Result<std::vector<double>> size =
+          NumbersIn(*shape, "size", at, 3, kMinShapeSize, kMaxShapeSize, true);
+      if (!size.ok()) return size.status();
+      if (Status status = CheckShapeExtents(Vec3((*size)[0], (*size)[1], (*size)[2]), at);
+          !status.ok()) {
+        return status;
+      }
+    } else if (kind == "cylinder") {
+      Result<std::vector<double>> radius =
+          NumbersIn(*shape, "radius", at, 1, kMinShapeSize, kMaxShapeSize, true);
+      if (!radius.ok()) return radius.status();
+      Result<std::vector<double>> length =
+          NumbersIn(*shape, "length", at, 1, kMinShapeSize, kMaxShapeSize, true);
+      if (!length.ok()) return length.status();
+      const double diameter = 2.0 * (*radius)[0];
+      if (Status status = CheckShapeExtents(Vec3(diameter, diameter, (*length)[0]), at);
+          !status.ok()) {
+        return status;
+      }
+    } else if (kind == "sphere") {
+      Result<std::vector<double>> radius =
+          NumbersIn(*shape, "radius", at, 1, kMinShapeSize, kMaxShapeSize, true);
+      if (!radius.ok()) return radius.status();
+    } else if (kind == "mesh") {
+      // The hull's own extents are checked once it is built.
+      Result<std::vector<double>> scale =
+          NumbersIn(*shape, "scale", at, 3, -kMaxShapeSize, kMaxShapeSize, false);
+      if (!scale.ok()) return scale.status();
+    }
+  }
+  return Status::Ok();
+}
+
+Status CheckInertial(const TiXmlElement& inertial, const std::string& where) {
+  const std::string at = where + ": invalid <inertial>:";
+  if (Status status = CheckOrigin(inertial, at); !status.ok()) return status;
+  if (const TiXmlElement* mass = inertial.FirstChildElement("mass"); mass != nullptr) {
+    Result<std::vector<double>> value =
+        NumbersIn(*mass, "value", at + " <mass>", 1, 0.0, 1e12, true);
+    if (!value.ok()) return value.status();
+  }
+  if (const TiXmlElement* inertia = inertial.FirstChildElement("inertia"); inertia != nullptr) {
+    for (const char* name : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
+      Result<std::vector<double>> value =
+          NumbersIn(*inertia, name, at + " <inertia>", 1, -1e20, 1e20, false);
+      if (!value.ok()) return value.status();
+    }
+  }
+  return Status::Ok();
+}
+
+Status CheckLink(const TiXmlElement& link) {
+  const char* name = link.Attribute("name");
+  const std::string where = "link " + Quoted(name == nullptr ? "" : name);
+  int index = 0;
+  for (const TiXmlElement* collision = link.FirstChildElement("collision"); collision != nullptr;
+       collision = collision->NextSiblingElement("collision"), ++index) {
+    const char* collision_name = collision->Attribute("name");
+    const std::string at =
+        where + " <collision> " +
+        (collision_name == nullptr || *collision_name == '\0' ? std::to_string(index)
+                                                              : Quoted(collision_name));
+    if (Status status = CheckOrigin(*collision, at); !status.ok()) return status;
+    if (const TiXmlElement* geometry = collision->FirstChildElement("geometry");
+        geometry != nullptr) {
+      if (Status status = CheckGeometry(*geometry, at); !status.ok()) return status;
+    }
+  }
+  if (const TiXmlElement* inertial = link.FirstChildElement("inertial"); inertial != nullptr) {
+    return CheckInertial(*inertial, where);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status CheckShapeExtents(const Vec3& extents, const std::string& what) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const double size = extents[axis];
+    if (!(size >= kMinShapeSize && size <= kMaxShapeSize)) {
+      return Status::Error(what + ": size " + FormatNumber(size) + " m along " + "xyz"[axis] +
+                           " is outside the allowed range " + Range(kMinShapeSize, kMaxShapeSize) +
+                           " m");
+    }
+  }
+  const double ratio = extents.maxCoeff() / extents.minCoeff();
+  if (!(ratio <= kMaxShapeAspectRatio)) {
+    return Status::Error(what + ": aspect ratio " + FormatNumber(ratio) +
+                         " (largest / smallest size) is above the allowed " +
+                         FormatNumber(kMaxShapeAspectRatio));
+  }
+  return Status::Ok();
+}
+
+Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
+  int links = 0;
+  for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    ++links;
+  }
+  if (links > options.max_links) {
+    return Status::Error("the model has " + std::to_string(links) +
+                         " links, above max_links_per_model " + std::to_string(options.max_links));
+  }
+  for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    if (Status status = CheckLink(*link); !status.ok()) return status;
+  }
+  for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const char* name = joint->Attribute("name");
+    if (Status status = CheckOrigin(*joint, "joint " + Quoted(name == nullptr ? "" : name));
+        !status.ok()) {
+      return status;
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace rigid_body_sim::io

@@ -1,0 +1,93 @@
+// rigid_body_sim_mesh_helper: imports one untrusted mesh file (assimp) and
+// builds its convex hull (qhull) in a process of its own, so that an abort,
+// a leak or a runaway allocation in the importer never reaches the node
+// (io/mesh_process.h starts it). It limits itself before it touches the
+// file, then writes the hull, or "error <why>", to its standard output.
+//
+// Usage: rigid_body_sim_mesh_helper PATH SX SY SZ MAX_VERTICES
+//        DEGENERATE_TOLERANCE MEMORY_BYTES CPU_SECONDS MAX_FILE_BYTES
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <string>
+
+#include "rigid_body_sim/io/convex_hull.h"
+#include "rigid_body_sim/io/mesh_loader.h"
+#include "rigid_body_sim/io/mesh_process.h"
+
+// GCC defines __SANITIZE_ADDRESS__; clang answers __has_feature.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define RBS_HAS_ADDRESS_SANITIZER 1
+#endif
+#endif
+#ifndef RBS_HAS_ADDRESS_SANITIZER
+#define RBS_HAS_ADDRESS_SANITIZER 0
+#endif
+
+namespace {
+
+using rigid_body_sim::physics::Result;
+
+int Reply(const std::string& text, int status) {
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  std::fflush(stdout);
+  return status;
+}
+
+// Address space, CPU time (soft: SIGXCPU; hard one second later: SIGKILL)
+// and no core files.
+bool LimitSelf(rlim_t memory_bytes, double cpu_seconds) {
+  const rlim_t cpu = static_cast<rlim_t>(cpu_seconds < 1.0 ? 1.0 : cpu_seconds);
+  const rlimit memory{memory_bytes, memory_bytes};
+  const rlimit cpu_limit{cpu, cpu + 1};
+  const rlimit none{0, 0};
+#if defined(__SANITIZE_ADDRESS__) || RBS_HAS_ADDRESS_SANITIZER
+  // AddressSanitizer has reserved terabytes of address space for its
+  // shadow before main: an address-space limit would fail every allocation.
+  (void)memory;
+#else
+  if (setrlimit(RLIMIT_AS, &memory) != 0) return false;
+#endif
+  return setrlimit(RLIMIT_CPU, &cpu_limit) == 0 && setrlimit(RLIMIT_CORE, &none) == 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using rigid_body_sim::io::FormatErrorReply;
+  if (argc != 10) return Reply(FormatErrorReply("mesh helper: expected 9 arguments"), 2);
+  const std::string path = argv[1];
+  const rigid_body_sim::physics::Vec3 scale(
+      std::strtod(argv[2], nullptr), std::strtod(argv[3], nullptr), std::strtod(argv[4], nullptr));
+  rigid_body_sim::io::HullOptions hull;
+  hull.max_vertices = std::atoi(argv[5]);
+  hull.degenerate_tolerance = std::strtod(argv[6], nullptr);
+  const unsigned long long memory_bytes = std::strtoull(argv[7], nullptr, 10);
+  const double cpu_seconds = std::strtod(argv[8], nullptr);
+  const unsigned long long max_file_bytes = std::strtoull(argv[9], nullptr, 10);
+  if (!LimitSelf(static_cast<rlim_t>(memory_bytes), cpu_seconds)) {
+    return Reply(FormatErrorReply("mesh helper: setrlimit failed"), 2);
+  }
+  try {
+    // The path is already resolved; take it as it is.
+    const auto as_is = [](const std::string& uri) -> Result<std::string> { return uri; };
+    const Result<rigid_body_sim::physics::TriangleMesh> mesh =
+        rigid_body_sim::io::LoadMesh(path, scale, as_is, max_file_bytes);
+    if (!mesh.ok()) return Reply(FormatErrorReply(mesh.message()), 1);
+    const Result<rigid_body_sim::physics::ConvexPolyhedron> built =
+        rigid_body_sim::io::ComputeConvexHull(mesh->vertices, hull);
+    if (!built.ok()) {
+      return Reply(FormatErrorReply("mesh '" + path + "': " + built.message()), 1);
+    }
+    return Reply(rigid_body_sim::io::FormatHullReply(*built), 0);
+  } catch (const std::bad_alloc&) {
+    return Reply(FormatErrorReply("mesh '" + path + "': out of memory in the mesh helper (limit " +
+                                  std::to_string(memory_bytes) + " bytes)"),
+                 1);
+  } catch (const std::exception& error) {
+    return Reply(FormatErrorReply("mesh '" + path + "': " + error.what()), 1);
+  }
+}
