@@ -182,13 +182,7 @@ class ModelBuilder {
 
  private:
   Result<LoadedModel> BuildModel(const urdf::ModelInterface& model) {
-    for (const auto& [name, joint] : model.joints_) {
-      if (joint->type != urdf::Joint::FIXED) {
-        return Result<LoadedModel>::Error(
-            "joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
-            "; only fixed joints are supported, movable joints are not simulated yet");
-      }
-    }
+    if (Status status = CheckJoints(model); !status.ok()) return status;
     for (const auto& [name, link] : model.links_) {
       if (name == kWorldLink && link != model.getRoot()) {
         return Result<LoadedModel>::Error("link 'world' must be the root of the model");
@@ -232,10 +226,69 @@ class ModelBuilder {
     return loaded;
   }
 
-  // Adds `link` and, through their fixed joints, all links below it.
+  // Refuses joints that cannot be welded, and joint positions that name no
+  // weldable joint or lie outside its limits.
+  Status CheckJoints(const urdf::ModelInterface& model) const {
+    for (const auto& [name, joint] : model.joints_) {
+      if (joint->type == urdf::Joint::FIXED) continue;
+      if (!options_.weld_movable_joints || !IsWeldable(joint->type)) {
+        return Status::Error(
+            "joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
+            "; only fixed joints are supported, movable joints are not simulated yet");
+      }
+    }
+    for (const auto& [name, position] : options_.joint_positions) {
+      const auto found = model.joints_.find(name);
+      if (found == model.joints_.end() || !IsWeldable(found->second->type)) {
+        std::string movable;
+        for (const auto& [other, joint] : model.joints_) {
+          if (IsWeldable(joint->type)) movable += (movable.empty() ? "" : ", ") + Quoted(other);
+        }
+        return Status::Error("joint " + Quoted(name) + " is not a movable joint of the model" +
+                             (movable.empty() ? " (it has none)" : "; movable: " + movable));
+      }
+      const urdf::Joint& joint = *found->second;
+      if (!std::isfinite(position)) {
+        return Status::Error("joint " + Quoted(name) + " position is not finite");
+      }
+      if (joint.type != urdf::Joint::CONTINUOUS && joint.limits != nullptr &&
+          (position < joint.limits->lower || position > joint.limits->upper)) {
+        const char* unit = joint.type == urdf::Joint::PRISMATIC ? " m" : " rad";
+        return Status::Error("joint " + Quoted(name) + " position " + FormatNumber(position) +
+                             unit + " is outside its limits [" + FormatNumber(joint.limits->lower) +
+                             ", " + FormatNumber(joint.limits->upper) + "]");
+      }
+    }
+    return Status::Ok();
+  }
+
+  static bool IsWeldable(int type) {
+    return type == urdf::Joint::REVOLUTE || type == urdf::Joint::CONTINUOUS ||
+           type == urdf::Joint::PRISMATIC;
+  }
+
+  // The child frame of a welded joint in its joint frame: a turn about the
+  // axis, or a slide along it.
+  Pose JointMotion(const urdf::Joint& joint, JointInfo* info, LoadedModel* loaded) const {
+    if (joint.type == urdf::Joint::FIXED) return Pose::Identity();
+    const auto given = options_.joint_positions.find(joint.name);
+    const double position = given == options_.joint_positions.end() ? 0.0 : given->second;
+    info->position = position;
+    loaded->warnings.push_back("joint " + Quoted(joint.name) + " is " + JointTypeName(joint.type) +
+                               "; welded at " + FormatNumber(position) +
+                               " (movable joints are not simulated yet)");
+    Vec3 axis(joint.axis.x, joint.axis.y, joint.axis.z);
+    if (!(axis.norm() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();  // URDF's default axis
+    axis.normalize();
+    if (joint.type == urdf::Joint::PRISMATIC) return Pose{axis * position, Quat::Identity()};
+    return Pose{Vec3::Zero(), Quat(Eigen::AngleAxisd(position, axis))};
+  }
+
+  // Adds `link` and, through their (welded) joints, all links below it.
   Status AddLink(const urdf::Link& link, const Pose& root_from_link, LoadedModel* loaded,
                  std::vector<MassProperties>* parts_in_root) {
-    loaded->links.push_back(LinkFrame{link.name, root_from_link});
+    const std::size_t link_index = loaded->links.size();
+    loaded->links.push_back(LinkFrame{link.name, root_from_link, 0.0});
     const auto friction = friction_.find(link.name);
 
     std::vector<MassProperties> geometry_parts_in_link;
@@ -264,12 +317,14 @@ class ModelBuilder {
     if (link.inertial != nullptr) {
       Result<MassProperties> inertial = InertialMassProperties(link);
       if (!inertial.ok()) return inertial.status();
+      loaded->links[link_index].mass = inertial->mass;
       parts_in_root->push_back(physics::TransformMassProperties(*inertial, root_from_link));
     } else if (!geometry_parts_in_link.empty()) {
       // Overlapping collision elements count twice; a URDF that needs exact
       // mass properties for overlapping geometry states its <inertial>.
-      parts_in_root->push_back(physics::TransformMassProperties(
-          physics::CombineMassProperties(geometry_parts_in_link), root_from_link));
+      const MassProperties from_geometry = physics::CombineMassProperties(geometry_parts_in_link);
+      loaded->links[link_index].mass = from_geometry.mass;
+      parts_in_root->push_back(physics::TransformMassProperties(from_geometry, root_from_link));
       if (!loaded->is_static) {
         loaded->warnings.push_back("link " + Quoted(link.name) +
                                    " has no <inertial>; mass computed from its collision "
@@ -286,7 +341,11 @@ class ModelBuilder {
       if (child == nullptr) {
         return Status::Error("joint " + Quoted(joint->name) + " has no child link");
       }
-      const Pose root_from_child = root_from_link * ToPose(joint->parent_to_joint_origin_transform);
+      JointInfo info{joint->name, JointTypeName(joint->type), link.name, child->name, 0.0};
+      const Pose root_from_child = root_from_link *
+                                   ToPose(joint->parent_to_joint_origin_transform) *
+                                   JointMotion(*joint, &info, loaded);
+      loaded->joints.push_back(std::move(info));
       const Status status = AddLink(*child, root_from_child, loaded, parts_in_root);
       if (!status.ok()) return status;
     }

@@ -86,7 +86,34 @@ Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request
   spec.is_static = request.is_static;
   spec.friction = request.friction;
   spec.restitution = request.restitution;
+  if (request.joint_positions.size() != request.joint_names.size()) {
+    return Result<ModelSpec>::Error(
+        "joint_positions has " + std::to_string(request.joint_positions.size()) + " values for " +
+        std::to_string(request.joint_names.size()) + " joint_names");
+  }
+  for (std::size_t i = 0; i < request.joint_names.size(); ++i) {
+    const std::string& name = request.joint_names[i];
+    if (!spec.joint_positions.emplace(name, request.joint_positions[i]).second) {
+      return Result<ModelSpec>::Error("joint_names[" + std::to_string(i) + "] '" + name +
+                                      "' is given twice");
+    }
+  }
   return spec;
+}
+
+void ModelPropertiesToMsg(const Model& model, rigid_body_sim::GetModelProperties::Response* msg) {
+  msg->root_link = model.links.front().link_name;
+  for (const io::LinkFrame& link : model.links) {
+    msg->link_names.push_back(link.link_name);
+    msg->link_masses.push_back(link.mass);
+  }
+  msg->mass = model.mass;
+  for (const io::JointInfo& joint : model.joints) {
+    msg->joint_names.push_back(joint.name);
+    msg->joint_types.push_back(joint.type);
+    msg->joint_positions.push_back(joint.position);
+  }
+  msg->is_static = model.is_static;
 }
 
 geometry_msgs::Vector3 VectorToMsg(const Vec3& vector) {
@@ -135,7 +162,13 @@ geometry_msgs::TransformStamped TransformToMsg(const Pose& parent_from_child,
   return msg;
 }
 
-ros::Time SimTimeToRos(double sim_time) { return ros::Time(std::max(sim_time, 0.0)); }
+ros::Time SimTimeToRos(double sim_time) {
+  // ros::Time throws beyond its unsigned 32-bit seconds; a sim time outside
+  // that range (or NaN) must not take the node down, so it is clamped.
+  if (!(sim_time > 0.0)) return ros::Time(0);
+  if (sim_time >= ros::TIME_MAX.toSec()) return ros::TIME_MAX;
+  return ros::Time(sim_time);
+}
 
 rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
                                      const std::string& body_a, const std::string& body_b) {

@@ -31,7 +31,10 @@ void SimNode::StepLocked() {
   wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(),
                                  [](const ActiveWrench& w) { return w.remaining_steps <= 0; }),
                   wrenches_.end());
+  const Clock::time_point start = Clock::now();
   world_.Step();
+  diagnostics_->RecordStep(std::chrono::duration<double>(Clock::now() - start).count(),
+                           world_.last_step_profile());
   ++steps_;
 }
 
@@ -50,6 +53,9 @@ void SimNode::StepLoop() {
   Clock::time_point next_publish = Clock::now();
   Clock::time_point next_clock = Clock::now();
   Clock::time_point next_status = Clock::now() + status_period;
+  const auto diagnostics_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(diagnostics_->period()));
+  Clock::time_point next_diagnostics = Clock::now() + diagnostics_period;
   for (;;) {
     Outbox outbox;
     {
@@ -89,12 +95,28 @@ void SimNode::StepLoop() {
         LogStatusLocked(now);
         next_status = now + status_period;
       }
+      if (now >= next_diagnostics) {
+        CloseDiagnosticsWindowLocked(now);
+        outbox.diagnostics = true;
+        next_diagnostics = now + diagnostics_period;
+      }
     }
     Publish(std::move(outbox));
     // Service callers waiting for the mutex go first, so a flat-out loop
     // cannot starve them.
     while (waiting_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
   }
+}
+
+void SimNode::CloseDiagnosticsWindowLocked(Clock::time_point now) {
+  WorldSnapshot snapshot;
+  snapshot.sim_time = world_.time();
+  snapshot.target_rtf = real_time_factor_;
+  snapshot.paused = paused_;
+  snapshot.bodies = registry_.size();
+  snapshot.awake = world_.AwakeBodyCount();
+  snapshot.contacts = world_.contacts().size();
+  diagnostics_->CloseWindow(snapshot, now);
 }
 
 void SimNode::LogStatusLocked(Clock::time_point now) {

@@ -28,6 +28,9 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
   load_options_.hull.max_vertices = options_.max_hull_vertices;
   load_options_.cylinder_segments = options_.cylinder_segments;
   load_options_.resolver = ResolveRosUri;
+  // A robot_description with movable joints spawns as one rigid body until
+  // joints are simulated; its joints keep their initial positions.
+  load_options_.weld_movable_joints = true;
 }
 
 SimNode::~SimNode() {
@@ -47,8 +50,8 @@ std::unique_lock<std::mutex> SimNode::LockWorld() {
 }
 
 Status SimNode::Start() {
-  tf_publisher_ = node_.advertise<tf2_msgs::TFMessage>(names::kTfTopic, 100);
-  tf_static_publisher_ = node_.advertise<tf2_msgs::TFMessage>(names::kTfStaticTopic, 1, true);
+  tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  static_broadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
   if (options_.use_sim_time) {
     clock_publisher_ = node_.advertise<rosgraph_msgs::Clock>(names::kClockTopic, 10);
   }
@@ -61,6 +64,8 @@ Status SimNode::Start() {
       names::kBodyMarkersTopic, 100, [this](const ros::SingleSubscriberPublisher& publisher) {
         OnBodyMarkersSubscriber(publisher);
       });
+
+  diagnostics_ = std::make_unique<SimDiagnostics>(node_, private_node_);
 
   if (options_.ground_plane) {
     physics::BodyDef ground;
@@ -87,7 +92,16 @@ Status SimNode::Start() {
   using Self = SimNode;
   services_.push_back(private_node_.advertiseService(names::kSpawnService, &Self::OnSpawn, this));
   services_.push_back(private_node_.advertiseService(names::kDeleteService, &Self::OnDelete, this));
-  services_.push_back(private_node_.advertiseService(names::kResetService, &Self::OnReset, this));
+  services_.push_back(
+      private_node_.advertiseService(names::kResetService, &Self::OnResetSimulation, this));
+  services_.push_back(private_node_.advertiseService(names::kResetSimulationService,
+                                                     &Self::OnResetSimulation, this));
+  services_.push_back(
+      private_node_.advertiseService(names::kResetWorldService, &Self::OnResetWorld, this));
+  services_.push_back(private_node_.advertiseService(names::kGetWorldPropertiesService,
+                                                     &Self::OnGetWorldProperties, this));
+  services_.push_back(private_node_.advertiseService(names::kGetModelPropertiesService,
+                                                     &Self::OnGetModelProperties, this));
   services_.push_back(
       private_node_.advertiseService(names::kSetPausedService, &Self::OnSetPaused, this));
   services_.push_back(private_node_.advertiseService(names::kStepService, &Self::OnStep, this));
@@ -118,13 +132,15 @@ Status SimNode::Start() {
 }
 
 Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
-  if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, load_options_);
+  io::UrdfLoadOptions options = load_options_;
+  options.joint_positions = spec.joint_positions;
+  if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, options);
   if (spec.urdf_path.empty()) {
     return Result<io::LoadedModel>::Error("neither urdf nor urdf_path is given");
   }
   Result<std::string> path = ResolveRosUri(spec.urdf_path);
   if (!path.ok()) return path.status();
-  return io::LoadUrdfFile(*path, load_options_);
+  return io::LoadUrdfFile(*path, options);
 }
 
 Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
@@ -157,6 +173,8 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     model.body = *body;
     model.is_static = def->is_static;
     model.links = loaded->links;
+    model.joints = loaded->joints;
+    model.mass = def->is_static ? 0.0 : def->mass_properties.mass;
     for (const io::LoadedShape& shape : loaded->shapes)
       model.shape_links.push_back(shape.link_name);
     model.spawn_state =

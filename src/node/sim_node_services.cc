@@ -72,39 +72,6 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
   return true;
 }
 
-bool SimNode::OnReset(std_srvs::Trigger::Request& /*request*/,
-                      std_srvs::Trigger::Response& response) {
-  Outbox outbox;
-  {
-    std::unique_lock<std::mutex> lock = LockWorld();
-    for (const auto& [name, model] : registry_.models()) {
-      const FrameState& state = model.spawn_state;
-      const Status status = world_.SetState(model.body, state.world_from_frame,
-                                            state.linear_velocity, state.angular_velocity);
-      assert(status.ok());
-    }
-    world_.Restart();
-    wrenches_.clear();
-    last_periodic_time_ = -1.0;
-    ReanchorLocked();
-    status_wall_ = Clock::now();
-    status_sim_ = 0.0;
-    outbox.tf_static = StaticTfLocked();
-    FillPeriodicLocked(&outbox);
-    {
-      std::lock_guard<std::mutex> clock_lock(clock_mutex_);
-      last_clock_ = 0.0;
-    }
-    ++reset_count_;
-  }
-  wake_.notify_all();
-  Publish(std::move(outbox));
-  response.success = true;
-  response.message = "reset: every model at its spawn state, sim time 0";
-  ROS_INFO("%s", response.message.c_str());
-  return true;
-}
-
 bool SimNode::OnSetPaused(std_srvs::SetBool::Request& request,
                           std_srvs::SetBool::Response& response) {
   {

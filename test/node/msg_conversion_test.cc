@@ -53,6 +53,15 @@ TEST(MsgConversionTest, ZeroQuaternionAndNonFiniteValuesAreRefusedByField) {
   EXPECT_EQ(state.message(), "twist.angular is not finite");
 }
 
+TEST(MsgConversionTest, SimTimeToRosClampsInsteadOfThrowing) {
+  EXPECT_EQ(SimTimeToRos(1.25), ros::Time(1, 250000000));
+  EXPECT_EQ(SimTimeToRos(-3.0), ros::Time(0));
+  EXPECT_EQ(SimTimeToRos(std::nan("")), ros::Time(0));
+  // ros::Time(5e9) would throw std::runtime_error.
+  EXPECT_EQ(SimTimeToRos(5e9), ros::TIME_MAX);
+  EXPECT_EQ(SimTimeToRos(std::numeric_limits<double>::infinity()), ros::TIME_MAX);
+}
+
 TEST(MsgConversionTest, PoseAndTwistRoundTrip) {
   const Pose pose{Vec3(0.5, -1.5, 2.5), Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()))};
   const auto back = PoseFromMsg(PoseToMsg(pose), "pose");
