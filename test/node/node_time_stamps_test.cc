@@ -28,8 +28,24 @@ class TimeStampsTest : public ::testing::Test {
     Spawn("stamp_box", BoxUrdf(0.5, 0.5, 0.5, 2.0), MakePose(0.0, 0.0, 30.0), false);
     Spawn("stamp_ball", SphereUrdf(0.2, 1.0), MakePose(2.0, 0.0, 25.0), false);
     Spawn("stamp_shelf", BoxUrdf(1.0, 1.0, 0.1, 5.0), MakePose(-3.0, 0.0, 1.0), true);
-    // Under sim time the test's clock is our /clock; a step makes it move.
-    ASSERT_TRUE(client_.Step(1).success);
+    // A listener has nothing from before it subscribed; once it holds each
+    // frame, lookups at its now must succeed from then on. Under paused sim
+    // time tf goes out only when a step moves time (and the test's clock,
+    // our /clock, with it), so a step is taken until the listener, which may
+    // still be connecting, has every frame. Polled in wall time: paused sim
+    // time would never end a tf2 timeout.
+    const auto listener_has_every_frame = [&] {
+      if (!client_.Step(1).success) return false;
+      return WaitFor(
+          [&] {
+            for (const std::string& name : spawned_) {
+              if (!buffer_.canTransform("world", name + "/base_link", ros::Time(0))) return false;
+            }
+            return true;
+          },
+          0.5);
+    };
+    ASSERT_TRUE(WaitFor(listener_has_every_frame, kTimeout));
   }
   void TearDown() override {
     for (const std::string& name : spawned_) client_.Delete(name);
@@ -53,6 +69,8 @@ class TimeStampsTest : public ::testing::Test {
       const std::string frame = name + "/base_link";
       const ros::Time now = ros::Time::now();
       try {
+        // Under sim time the timeout runs in sim time, which stands still
+        // while paused; there tf already holds the paused instant.
         const auto transform = buffer_.lookupTransform("world", frame, now, ros::Duration(2.0));
         const auto state = client_.GetState(name);
         ASSERT_TRUE(state.success) << state.message;
