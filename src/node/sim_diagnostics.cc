@@ -7,8 +7,8 @@ namespace rigid_body_sim::node {
 
 void FillDiagnostics(const DiagnosticsWindow& window,
                      diagnostic_updater::DiagnosticStatusWrapper* status) {
-  const double achieved = window.wall_seconds > 0.0 ? window.sim_seconds / window.wall_seconds
-                                                    : 0.0;
+  const double achieved =
+      window.wall_seconds > 0.0 ? window.sim_seconds / window.wall_seconds : 0.0;
   const double mean_ms =
       window.steps > 0 ? 1e3 * window.step_seconds_sum / static_cast<double>(window.steps) : 0.0;
   const WorldSnapshot& world = window.world;

@@ -16,8 +16,9 @@ import unittest
 
 import rospkg
 import rospy
-from rigid_body_sim.srv import (GetModelProperties, GetState, GetWorldProperties, SetState,
-                                SetStateRequest, Step)
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rigid_body_sim.srv import (GetModelProperties, GetPhysics, GetState, GetWorldProperties,
+                                SetPhysics, SetState, SetStateRequest, Step)
 from std_srvs.srv import SetBool, Trigger
 
 PKG = 'rigid_body_sim'
@@ -182,6 +183,36 @@ class SpawnModelTest(unittest.TestCase):
                                      '-reference_frame', 'no_table/base_link')
         self.assertEqual(1, status)
         self.assertIn("no model named 'no_table'", output)
+
+    def next_diagnostics(self):
+        """The physics status of the next /diagnostics message after the call."""
+        message = rospy.wait_for_message('/diagnostics', DiagnosticArray, timeout=10)
+        statuses = [status for status in message.status
+                    if status.name == 'rigid_body_sim: physics']
+        self.assertEqual(1, len(statuses), message)
+        return statuses[0], {value.key: value.value for value in statuses[0].values}
+
+    def test_diagnostics_report_the_world_and_warn_when_real_time_is_lost(self):
+        status, values = self.next_diagnostics()
+        self.assertEqual(DiagnosticStatus.OK, status.level)
+        self.assertEqual('paused', status.message)
+        self.assertEqual(str(len(self.world().model_names)), values['models'])
+        physics = service('get_physics', GetPhysics)()
+        set_physics = service('set_physics', SetPhysics)
+        # A million times real time needs 2.4e8 steps/s: out of reach.
+        self.assertTrue(set_physics(physics.gravity, physics.time_step, 1e6).success)
+        try:
+            self.set_paused(False)
+            self.next_diagnostics()  # the window that saw the change
+            status, values = self.next_diagnostics()
+            self.assertEqual(DiagnosticStatus.WARN, status.level, status.message)
+            self.assertIn('real-time factor 1e+06 cannot be held', status.message)
+            self.assertLess(float(values['real-time factor achieved']), 0.9e6)
+            self.assertGreater(int(values['steps in window']), 0)
+            self.assertGreater(float(values['step time mean (ms)']), 0.0)
+        finally:
+            self.set_paused(True)
+            set_physics(physics.gravity, physics.time_step, physics.real_time_factor)
 
     def test_unknown_model_properties_are_refused(self):
         props = self.model('no_such_model')

@@ -17,8 +17,8 @@ namespace rigid_body_sim::node {
 
 // The world's state when a window closes.
 struct WorldSnapshot {
-  double sim_time = 0.0;     // s
-  double target_rtf = 1.0;   // the ~real_time_factor asked for; 0 = flat out
+  double sim_time = 0.0;    // s
+  double target_rtf = 1.0;  // the ~real_time_factor asked for; 0 = flat out
   bool paused = false;
   std::size_t bodies = 0;    // models
   std::size_t awake = 0;     // dynamic bodies being integrated
