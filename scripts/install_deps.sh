@@ -7,6 +7,7 @@ packages=(
   build-essential cmake git
   catkin ros-core-dev libroscpp-dev libroslib-dev ros-message-generation ros-message-runtime
   libtf2-ros-dev liburdfdom-dev liburdf-dev libdiagnostic-updater-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev libvisualization-msgs-dev
   libassimp-dev libqhull-dev libeigen3-dev
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash

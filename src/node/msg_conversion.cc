@@ -291,4 +291,34 @@ visualization_msgs::MarkerArray ContactMarkers(const std::vector<physics::Contac
   return array;
 }
 
+LiveSettings LiveSettingsFromConfig(const rigid_body_sim::PhysicsConfig& config) {
+  LiveSettings settings;
+  settings.gravity = Vec3(config.gravity_x, config.gravity_y, config.gravity_z);
+  settings.time_step = config.time_step;
+  settings.real_time_factor = config.real_time_factor;
+  settings.publish_rate = config.publish_rate;
+  settings.defaults.friction = config.default_friction;
+  settings.defaults.restitution = config.default_restitution;
+  settings.velocity_iterations = config.solver_velocity_iterations;
+  settings.position_iterations = config.solver_position_iterations;
+  settings.sleep_linear_velocity = config.sleep_linear_velocity;
+  settings.sleep_angular_velocity = config.sleep_angular_velocity;
+  return settings;
+}
+
+void LiveSettingsToConfig(const LiveSettings& settings, rigid_body_sim::PhysicsConfig* config) {
+  config->gravity_x = settings.gravity.x();
+  config->gravity_y = settings.gravity.y();
+  config->gravity_z = settings.gravity.z();
+  config->time_step = settings.time_step;
+  config->real_time_factor = settings.real_time_factor;
+  config->publish_rate = settings.publish_rate;
+  config->default_friction = settings.defaults.friction;
+  config->default_restitution = settings.defaults.restitution;
+  config->solver_velocity_iterations = settings.velocity_iterations;
+  config->solver_position_iterations = settings.position_iterations;
+  config->sleep_linear_velocity = settings.sleep_linear_velocity;
+  config->sleep_angular_velocity = settings.sleep_angular_velocity;
+}
+
 }  // namespace rigid_body_sim::node

@@ -44,13 +44,10 @@ void SimNode::ReanchorLocked() {
 }
 
 void SimNode::StepLoop() {
-  const auto publish_period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / options_.publish_rate));
   const auto clock_period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(kClockPeriodSeconds));
   const auto status_period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(options_.status_period));
-  Clock::time_point next_publish = Clock::now();
   Clock::time_point next_clock = Clock::now();
   Clock::time_point next_status = Clock::now() + status_period;
   const auto diagnostics_period = std::chrono::duration_cast<Clock::duration>(
@@ -62,16 +59,16 @@ void SimNode::StepLoop() {
       std::unique_lock<std::mutex> lock(mutex_);
       if (shutdown_) return;
       if (paused_) {
-        wake_.wait_until(lock, next_publish, [this] { return shutdown_ || !paused_; });
+        wake_.wait_until(lock, next_publish_, [this] { return shutdown_ || !paused_; });
         if (shutdown_) return;
-      } else if (real_time_factor_ > 0.0) {
+      } else if (live_.real_time_factor > 0.0) {
         // Real-time pacing: the next step is due when the wall clock has
         // caught up with sim time / real_time_factor.
         const auto due = anchor_wall_ +
                          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                             (world_.time() - anchor_sim_) / real_time_factor_));
+                             (world_.time() - anchor_sim_) / live_.real_time_factor));
         if (Clock::now() < due) {
-          const auto wake_at = std::min(due, next_publish);
+          const auto wake_at = std::min(due, next_publish_);
           const auto anchor = anchor_wall_;
           wake_.wait_until(lock, wake_at,
                            [&] { return shutdown_ || paused_ || anchor_wall_ != anchor; });
@@ -84,9 +81,11 @@ void SimNode::StepLoop() {
         StepLocked();
       }
       const Clock::time_point now = Clock::now();
-      if (now >= next_publish) {
+      if (now >= next_publish_) {
         FillPeriodicLocked(&outbox);
-        next_publish = std::max(next_publish + publish_period, now);
+        const auto publish_period = std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double>(1.0 / live_.publish_rate));
+        next_publish_ = std::max(next_publish_ + publish_period, now);
       } else if (options_.use_sim_time && now >= next_clock && world_.time() > 0.0) {
         outbox.clock = world_.time();
       }
@@ -111,7 +110,7 @@ void SimNode::StepLoop() {
 void SimNode::CloseDiagnosticsWindowLocked(Clock::time_point now) {
   WorldSnapshot snapshot;
   snapshot.sim_time = world_.time();
-  snapshot.target_rtf = real_time_factor_;
+  snapshot.target_rtf = live_.real_time_factor;
   snapshot.paused = paused_;
   snapshot.bodies = registry_.size();
   snapshot.awake = world_.AwakeBodyCount();

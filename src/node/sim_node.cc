@@ -23,7 +23,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       private_node_(std::move(private_node)),
       world_(options_.world),
       paused_(options_.paused),
-      real_time_factor_(options_.real_time_factor) {
+      live_(LiveSettingsOf(options_)) {
   load_options_.default_density = options_.default_density;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
   load_options_.cylinder_segments = options_.cylinder_segments;
@@ -119,14 +119,16 @@ Status SimNode::Start() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ReanchorLocked();
+    next_publish_ = Clock::now();
     // The frames spawned so far went out with the current stamp already.
     last_periodic_time_ = world_.time();
     status_wall_ = Clock::now();
     status_sim_ = world_.time();
   }
+  StartReconfigure();
   loop_thread_ = std::thread([this] { StepLoop(); });
   ROS_INFO("rigid_body_sim: %zu models, time step %g s, real-time factor %g%s, world frame '%s'",
-           options_.models.size(), options_.world.time_step, options_.real_time_factor,
+           options_.models.size(), live_.time_step, live_.real_time_factor,
            options_.paused ? ", paused" : "", options_.world_frame.c_str());
   return Status::Ok();
 }
@@ -146,6 +148,7 @@ Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
 Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
   using FramesResult = Result<std::vector<std::string>>;
   if (Status status = ValidateModelName(spec.name); !status.ok()) return status;
+  MaterialDefaults defaults;
   {
     // Early refusal of a taken name spares loading the model; the name is
     // checked again when the body is added.
@@ -153,10 +156,11 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     if (registry_.Find(spec.name) != nullptr) {
       return FramesResult::Error("a model named '" + spec.name + "' already exists");
     }
+    defaults = live_.defaults;
   }
   Result<io::LoadedModel> loaded = LoadModel(spec);
   if (!loaded.ok()) return loaded.status();
-  Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, options_.defaults);
+  Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, defaults);
   if (!def.ok()) return def.status();
 
   Outbox outbox;

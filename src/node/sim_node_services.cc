@@ -177,9 +177,9 @@ bool SimNode::OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
 bool SimNode::OnGetPhysics(rigid_body_sim::GetPhysics::Request& /*request*/,
                            rigid_body_sim::GetPhysics::Response& response) {
   std::unique_lock<std::mutex> lock = LockWorld();
-  response.gravity = VectorToMsg(world_.settings().gravity);
-  response.time_step = world_.settings().time_step;
-  response.real_time_factor = real_time_factor_;
+  response.gravity = VectorToMsg(live_.gravity);
+  response.time_step = live_.time_step;
+  response.real_time_factor = live_.real_time_factor;
   return true;
 }
 
@@ -187,31 +187,30 @@ bool SimNode::OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
                            rigid_body_sim::SetPhysics::Response& response) {
   const char* service = names::kSetPhysicsService;
   Result<Vec3> gravity = VectorFromMsg(request.gravity, "gravity");
-  if (!gravity.ok()) return Fail(response, gravity.message(), service);
-  if (!(request.time_step > 0.0) || !std::isfinite(request.time_step)) {
-    return Fail(response, "time_step " + FormatNumber(request.time_step) + " s must be positive",
-                service);
-  }
-  if (!(request.real_time_factor >= 0.0) || !std::isfinite(request.real_time_factor)) {
-    return Fail(response,
-                "real_time_factor " + FormatNumber(request.real_time_factor) +
-                    " must be >= 0 (0: as fast as possible)",
-                service);
-  }
+  if (!request.keep_gravity && !gravity.ok()) return Fail(response, gravity.message(), service);
+  std::vector<std::string> warnings;
   {
     std::unique_lock<std::mutex> lock = LockWorld();
-    physics::WorldSettings settings = world_.settings();
-    settings.gravity = *gravity;
-    settings.time_step = request.time_step;
-    if (Status status = world_.SetSettings(settings); !status.ok()) {
+    LiveSettings settings = live_;
+    if (!request.keep_gravity) settings.gravity = *gravity;
+    if (request.time_step != 0.0) settings.time_step = request.time_step;
+    if (!(request.real_time_factor < 0.0)) settings.real_time_factor = request.real_time_factor;
+    if (Status status = ValidateLiveSettings(settings, ""); !status.ok()) {
       return Fail(response, status.message(), service);
     }
-    real_time_factor_ = request.real_time_factor;
-    ReanchorLocked();
+    if (Status status = ApplyLiveSettingsLocked(settings); !status.ok()) {
+      return Fail(response, status.message(), service);
+    }
+    warnings = LiveSettingsWarnings(settings, "");
   }
   wake_.notify_all();
+  PushReconfigureConfig();
   response.success = true;
   response.message = "physics set";
+  for (const std::string& warning : warnings) {
+    ROS_WARN("~%s: %s", service, warning.c_str());
+    response.message += "; warning: " + warning;
+  }
   return true;
 }
 

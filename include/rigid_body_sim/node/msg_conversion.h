@@ -18,8 +18,10 @@
 
 #include "rigid_body_sim/Contact.h"
 #include "rigid_body_sim/GetModelProperties.h"
+#include "rigid_body_sim/PhysicsConfig.h"
 #include "rigid_body_sim/Spawn.h"
 #include "rigid_body_sim/node/model_registry.h"
+#include "rigid_body_sim/node/options.h"
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/shape.h"
@@ -64,6 +66,12 @@ rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
 
 // Links with masses, joints and whether it is static (no success/message).
 void ModelPropertiesToMsg(const Model& model, rigid_body_sim::GetModelProperties::Response* msg);
+
+// --- dynamic_reconfigure (cfg/Physics.cfg) -----------------------------------
+
+// Unchecked; ValidateLiveSettings checks.
+LiveSettings LiveSettingsFromConfig(const rigid_body_sim::PhysicsConfig& config);
+void LiveSettingsToConfig(const LiveSettings& settings, rigid_body_sim::PhysicsConfig* config);
 
 // --- markers ----------------------------------------------------------------
 

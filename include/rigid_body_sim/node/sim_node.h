@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
@@ -22,6 +23,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <boost/thread/recursive_mutex.hpp>
 
 #include "rigid_body_sim/ApplyWrench.h"
 #include "rigid_body_sim/Contacts.h"
@@ -31,6 +33,7 @@
 #include "rigid_body_sim/GetState.h"
 #include "rigid_body_sim/GetWorldProperties.h"
 #include "rigid_body_sim/ModelStates.h"
+#include "rigid_body_sim/PhysicsConfig.h"
 #include "rigid_body_sim/SetPhysics.h"
 #include "rigid_body_sim/SetState.h"
 #include "rigid_body_sim/Spawn.h"
@@ -119,6 +122,16 @@ class SimNode {
                     rigid_body_sim::SetPhysics::Response& response);
   void OnBodyMarkersSubscriber(const ros::SingleSubscriberPublisher& publisher);
 
+  // Live parameters (sim_reconfigure.cc). The dynamic_reconfigure server
+  // takes its own mutex, then the world's; nothing takes them the other way
+  // round (PushReconfigureConfig runs without the world lock).
+  void StartReconfigure();
+  void OnReconfigure(rigid_body_sim::PhysicsConfig& config, std::uint32_t level);
+  // Shows the running values in the server (after ~set_physics).
+  void PushReconfigureConfig();
+  // Validated settings into the world and the loop; the caller wakes it.
+  physics::Status ApplyLiveSettingsLocked(const LiveSettings& settings);
+
   void StepLoop();
   // The callers of these hold the mutex.
   void StepLocked();
@@ -157,6 +170,8 @@ class SimNode {
   ros::Publisher body_markers_publisher_;
   std::vector<ros::ServiceServer> services_;
   std::unique_ptr<SimDiagnostics> diagnostics_;
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<rigid_body_sim::PhysicsConfig>> reconfigure_;
 
   std::mutex mutex_;
   std::condition_variable wake_;  // pause, resume, settings, shutdown
@@ -168,13 +183,15 @@ class SimNode {
   std::map<std::string, std::vector<visualization_msgs::Marker>> body_markers_;  // by model
   bool paused_ = false;
   bool shutdown_ = false;
-  double real_time_factor_ = 1.0;
+  LiveSettings live_;                 // what ~set_physics and dynamic_reconfigure change
   double last_periodic_time_ = -1.0;  // sim time of the last tf and contacts
   int contact_marker_count_ = 0;      // contacts drawn in the last contact markers
   std::uint64_t steps_ = 0;
   // Pacing: sim time anchor_sim_ is due at wall time anchor_wall_.
   Clock::time_point anchor_wall_;
   double anchor_sim_ = 0.0;
+  // When the loop next publishes; a new ~publish_rate takes effect at once.
+  Clock::time_point next_publish_;
   Clock::time_point status_wall_;
   double status_sim_ = 0.0;
 
