@@ -89,6 +89,26 @@ Status SimNode::Start() {
     }
   }
 
+  AdvertiseServices();
+
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ReanchorLocked();
+    next_publish_ = Clock::now();
+    // The frames spawned so far went out with the current stamp already.
+    last_periodic_time_ = world_.time();
+    status_wall_ = Clock::now();
+    status_sim_ = world_.time();
+  }
+  StartReconfigure();
+  loop_thread_ = std::thread([this] { StepLoop(); });
+  ROS_INFO("rigid_body_sim: %zu models, time step %g s, real-time factor %g%s, world frame '%s'",
+           options_.models.size(), live_.time_step, live_.real_time_factor,
+           options_.paused ? ", paused" : "", options_.world_frame.c_str());
+  return Status::Ok();
+}
+
+void SimNode::AdvertiseServices() {
   using Self = SimNode;
   services_.push_back(private_node_.advertiseService(names::kSpawnService, &Self::OnSpawn, this));
   services_.push_back(private_node_.advertiseService(names::kDeleteService, &Self::OnDelete, this));
@@ -115,22 +135,6 @@ Status SimNode::Start() {
       private_node_.advertiseService(names::kGetPhysicsService, &Self::OnGetPhysics, this));
   services_.push_back(
       private_node_.advertiseService(names::kSetPhysicsService, &Self::OnSetPhysics, this));
-
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ReanchorLocked();
-    next_publish_ = Clock::now();
-    // The frames spawned so far went out with the current stamp already.
-    last_periodic_time_ = world_.time();
-    status_wall_ = Clock::now();
-    status_sim_ = world_.time();
-  }
-  StartReconfigure();
-  loop_thread_ = std::thread([this] { StepLoop(); });
-  ROS_INFO("rigid_body_sim: %zu models, time step %g s, real-time factor %g%s, world frame '%s'",
-           options_.models.size(), live_.time_step, live_.real_time_factor,
-           options_.paused ? ", paused" : "", options_.world_frame.c_str());
-  return Status::Ok();
 }
 
 Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {

@@ -88,6 +88,8 @@ class SimNode {
   };
   using Clock = std::chrono::steady_clock;
 
+  void AdvertiseServices();
+
   // Locks the world mutex, telling the step loop to let the caller in first.
   std::unique_lock<std::mutex> LockWorld();
 
