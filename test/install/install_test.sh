@@ -22,6 +22,16 @@ trap cleanup EXIT
 
 echo "[install_test] cmake --install $build_dir --prefix $prefix"
 cmake --install "$build_dir" --prefix "$prefix" > "$prefix/install.log"
+# catkin installs its setup files to the configured prefix by absolute path,
+# which --prefix does not redirect; they are the ones generated for the
+# install space, copied as `catkin_make install` would.
+for file in setup.sh setup.bash local_setup.sh local_setup.bash _setup_util.py env.sh; do
+  cp "$build_dir/catkin_generated/installspace/$file" "$prefix/"
+done
+# Only catkin's own package.xml may be a link (build/.ws links the sources);
+# everything of ours must be copied, or the install space needs the sources.
+links=$(cd "$prefix" && find . -type l ! -path ./share/rigid_body_sim/package.xml)
+[ -z "$links" ] || { echo "[install_test] links into the source tree: $links" >&2; exit 1; }
 
 for path in lib/rigid_body_sim/rigid_body_sim_node lib/rigid_body_sim/drop_demo \
   lib/rigid_body_sim/spawn_model share/rigid_body_sim/package.xml \
@@ -42,7 +52,9 @@ env -i HOME="$prefix" PATH=/usr/bin:/bin LANG=C.UTF-8 \
   ROS_MASTER_URI="http://127.0.0.1:$port" ROS_HOSTNAME=127.0.0.1 ROS_LOG_DIR="$prefix/log" \
   PREFIX="$prefix" CALLER="$caller" PORT="$port" \
   bash -euo pipefail -c '
+    set +u  # the setup files read unset variables
     _CATKIN_SETUP_DIR=$PREFIX source "$PREFIX/setup.bash"
+    set -u
     found=$(rospack find rigid_body_sim)
     [ "$found" = "$PREFIX/share/rigid_body_sim" ] || {
       echo "[install_test] rospack finds $found, not the install space" >&2; exit 1; }
@@ -51,8 +63,12 @@ env -i HOME="$prefix" PATH=/usr/bin:/bin LANG=C.UTF-8 \
     echo $! > "$PREFIX/launch.pid"
     models() {
       python3 - <<EOF
-import rospy
+import rosgraph, rospy, time
 from rigid_body_sim.srv import GetWorldProperties
+deadline = time.monotonic() + 60
+while not rosgraph.is_master_online() and time.monotonic() < deadline:
+    time.sleep(0.2)
+rospy.init_node("install_test", anonymous=True, disable_signals=True)
 rospy.wait_for_service("/rigid_body_sim/get_world_properties", timeout=60)
 print(" ".join(rospy.ServiceProxy("/rigid_body_sim/get_world_properties", GetWorldProperties)().model_names))
 EOF

@@ -18,7 +18,8 @@ import rospkg
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rigid_body_sim.srv import (GetModelProperties, GetPhysics, GetState, GetWorldProperties,
-                                SetPhysics, SetState, SetStateRequest, Step)
+                                SetPhysics, SetPhysicsRequest, SetState, SetStateRequest,
+                                Step)
 from std_srvs.srv import SetBool, Trigger
 
 PKG = 'rigid_body_sim'
@@ -200,7 +201,8 @@ class SpawnModelTest(unittest.TestCase):
         physics = service('get_physics', GetPhysics)()
         set_physics = service('set_physics', SetPhysics)
         # A million times real time needs 2.4e8 steps/s: out of reach.
-        self.assertTrue(set_physics(physics.gravity, physics.time_step, 1e6).success)
+        self.assertTrue(set_physics(SetPhysicsRequest(keep_gravity=True, time_step=0.0,
+                                                      real_time_factor=1e6)).success)
         try:
             self.set_paused(False)
             self.next_diagnostics()  # the window that saw the change
@@ -212,7 +214,8 @@ class SpawnModelTest(unittest.TestCase):
             self.assertGreater(float(values['step time mean (ms)']), 0.0)
         finally:
             self.set_paused(True)
-            set_physics(physics.gravity, physics.time_step, physics.real_time_factor)
+            set_physics(SetPhysicsRequest(keep_gravity=True, time_step=0.0,
+                                          real_time_factor=physics.real_time_factor))
 
     def test_unknown_model_properties_are_refused(self):
         props = self.model('no_such_model')
