@@ -10,11 +10,13 @@ set -euo pipefail
 build_dir=${1:?usage: install_test.sh <catkin build directory>}
 prefix=$(mktemp -d /tmp/rbs_install.XXXXXX)
 launch_pid=
+# roslaunch runs in a session of its own (setsid), so that its master and
+# nodes can be stopped together: SIGINT, then SIGKILL after 30 s.
 cleanup() {
   if [ -n "$launch_pid" ] && kill -0 "$launch_pid" 2> /dev/null; then
-    kill -INT "$launch_pid" 2> /dev/null || true
-    for _ in $(seq 50); do kill -0 "$launch_pid" 2> /dev/null || break; sleep 0.2; done
-    kill -KILL "$launch_pid" 2> /dev/null || true
+    kill -INT -- "-$launch_pid" 2> /dev/null || true
+    for _ in $(seq 150); do kill -0 -- "-$launch_pid" 2> /dev/null || break; sleep 0.2; done
+    kill -KILL -- "-$launch_pid" 2> /dev/null || true
   fi
   rm -rf "$prefix"
 }
@@ -59,7 +61,7 @@ env -i HOME="$prefix" PATH=/usr/bin:/bin LANG=C.UTF-8 \
     [ "$found" = "$PREFIX/share/rigid_body_sim" ] || {
       echo "[install_test] rospack finds $found, not the install space" >&2; exit 1; }
     echo "[install_test] roslaunch -p $PORT rigid_body_sim demo.launch"
-    roslaunch -p "$PORT" rigid_body_sim demo.launch real_time_factor:=0 > "$PREFIX/launch.log" 2>&1 &
+    setsid roslaunch -p "$PORT" rigid_body_sim demo.launch > "$PREFIX/launch.log" 2>&1 &
     echo $! > "$PREFIX/launch.pid"
     models() {
       python3 - <<EOF
