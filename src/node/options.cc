@@ -1,6 +1,7 @@
 #include "rigid_body_sim/node/options.h"
 
 #include <cmath>
+#include <map>
 #include <set>
 #include <type_traits>
 #include <variant>
@@ -81,13 +82,27 @@ Status ReadParam(const ros::NodeHandle& node, const std::string& name, Reader re
   return reader(value, "parameter " + shown, out);
 }
 
+// `joints: {elbow: 0.5, ...}`: initial positions of movable joints, rad or m.
+Status ReadJoints(XmlRpc::XmlRpcValue& value, const std::string& what,
+                  std::map<std::string, double>* out) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    return Status::Error(what + " must be a dictionary {joint: position}");
+  }
+  for (auto& [name, position] : value) {
+    if (!IsNumber(position)) return Status::Error(what + "." + name + " must be a number");
+    (*out)[name] = ToDouble(position);
+  }
+  return Status::Ok();
+}
+
 Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
   const std::string what = "~models[" + std::to_string(index) + "]";
   if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     return Status::Error(what + " must be a dictionary");
   }
-  static const std::set<std::string> kKeys = {"name",  "urdf",      "urdf_path", "pose",
-                                              "twist", "is_static", "friction",  "restitution"};
+  static const std::set<std::string> kKeys = {"name",     "urdf",        "urdf_path",
+                                              "pose",     "twist",       "is_static",
+                                              "friction", "restitution", "joints"};
   for (auto& [key, unused] : entry) {
     if (kKeys.count(key) == 0) return Status::Error(what + " has an unknown field '" + key + "'");
   }
@@ -101,7 +116,8 @@ Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
         read_field("urdf_path", ReadString, &spec->urdf_path),
         read_field("is_static", ReadBool, &spec->is_static),
         read_field("friction", ReadDouble, &spec->friction),
-        read_field("restitution", ReadDouble, &spec->restitution)}) {
+        read_field("restitution", ReadDouble, &spec->restitution),
+        read_field("joints", ReadJoints, &spec->joint_positions)}) {
     if (!status.ok()) return status;
   }
   std::vector<double> values;

@@ -217,6 +217,14 @@ class SpawnModelTest(unittest.TestCase):
             set_physics(SetPhysicsRequest(keep_gravity=True, time_step=0.0,
                                           real_time_factor=physics.real_time_factor))
 
+    def test_world_entries_place_movable_joints(self):
+        props = self.model('arm_world')
+        self.assertTrue(props.success, props.message)
+        self.assertEqual([-0.75, 0.0], list(props.joint_positions))
+        q = self.get_state('arm_world/forearm').pose.orientation
+        self.assertAlmostEqual(math.sin(-0.375), q.z, delta=1e-12)
+        self.assertAlmostEqual(math.cos(-0.375), q.w, delta=1e-12)
+
     def test_unknown_model_properties_are_refused(self):
         props = self.model('no_such_model')
         self.assertFalse(props.success)

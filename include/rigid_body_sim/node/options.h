@@ -49,7 +49,8 @@ struct NodeOptions {
   // ~models: spawned at start-up, in order; each entry has the fields of
   // Spawn (name, urdf, urdf_path, is_static, friction, restitution), pose:
   // [x, y, z, roll, pitch, yaw] (m, rad; default all 0) and twist:
-  // [vx, vy, vz, wx, wy, wz] (m/s, rad/s; default all 0).
+  // [vx, vy, vz, wx, wy, wz] (m/s, rad/s; default all 0) and joints:
+  // {name: position} (rad or m, as Spawn's joint fields).
   std::vector<ModelSpec> models;
 };
 
