@@ -115,6 +115,13 @@ class LiveParamsTest(unittest.TestCase):
         self.assertIn('warning: time_step 0.05 s is above 1/30 s', response.message)
         self.assertEqual(0.05, self.get_physics().time_step)
         self.assertEqual(-9.81, self.get_physics().gravity.z)
+        # The server has it before the reply (its parameter is written then);
+        # a client hears it on ~parameter_updates shortly after.
+        self.assertEqual(0.05, rospy.get_param(NODE + '/time_step'))
+        deadline = time.monotonic() + 10.0
+        while (self.client.get_configuration(timeout=10)['time_step'] != 0.05 and
+               time.monotonic() < deadline):
+            time.sleep(0.05)
         self.assertEqual(0.05, self.client.get_configuration(timeout=10)['time_step'])
 
     def test_gravity_is_live(self):
