@@ -6,14 +6,15 @@ set -euo pipefail
 packages=(
   build-essential cmake git
   catkin ros-core-dev libroscpp-dev libroslib-dev ros-message-generation ros-message-runtime
-  libtf2-ros-dev liburdfdom-dev liburdf-dev libresource-retriever-dev
+  libtf2-ros-dev liburdfdom-dev liburdf-dev libdiagnostic-updater-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev libvisualization-msgs-dev
   libassimp-dev libqhull-dev libeigen3-dev
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
   libbullet-dev libbenchmark-dev python3-matplotlib
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
   python3-geometry-msgs python3-std-msgs python3-std-srvs python3-visualization-msgs
-  python3-rosgraph-msgs python3-tf2-msgs
+  python3-rosgraph-msgs python3-tf2-msgs python3-diagnostic-msgs
   clang libclang-rt-14-dev
 )
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -191,13 +192,7 @@ class ModelBuilder {
 
  private:
   Result<LoadedModel> BuildModel(const urdf::ModelInterface& model) {
-    for (const auto& [name, joint] : model.joints_) {
-      if (joint->type != urdf::Joint::FIXED) {
-        return Result<LoadedModel>::Error(
-            "joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
-            "; only fixed joints are supported, movable joints are not simulated yet");
-      }
-    }
+    if (Status status = CheckJoints(model); !status.ok()) return status;
     for (const auto& [name, link] : model.links_) {
       if (name == kWorldLink && link != model.getRoot()) {
         return Result<LoadedModel>::Error("link 'world' must be the root of the model");
@@ -241,29 +236,100 @@ class ModelBuilder {
     return loaded;
   }
 
-  // Adds `root` and, through their fixed joints, all links below it, in
+  // Refuses joints that cannot be welded, and joint positions that name no
+  // weldable joint or lie outside its limits.
+  Status CheckJoints(const urdf::ModelInterface& model) const {
+    for (const auto& [name, joint] : model.joints_) {
+      if (joint->type == urdf::Joint::FIXED) continue;
+      if (!options_.weld_movable_joints || !IsWeldable(joint->type)) {
+        return Status::Error(
+            "joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
+            "; only fixed joints are supported, movable joints are not simulated yet");
+      }
+    }
+    for (const auto& [name, position] : options_.joint_positions) {
+      const auto found = model.joints_.find(name);
+      if (found == model.joints_.end() || !IsWeldable(found->second->type)) {
+        std::string movable;
+        for (const auto& [other, joint] : model.joints_) {
+          if (IsWeldable(joint->type)) movable += (movable.empty() ? "" : ", ") + Quoted(other);
+        }
+        return Status::Error("joint " + Quoted(name) + " is not a movable joint of the model" +
+                             (movable.empty() ? " (it has none)" : "; movable: " + movable));
+      }
+      const urdf::Joint& joint = *found->second;
+      if (!std::isfinite(position)) {
+        return Status::Error("joint " + Quoted(name) + " position is not finite");
+      }
+      if (joint.type != urdf::Joint::CONTINUOUS && joint.limits != nullptr &&
+          (position < joint.limits->lower || position > joint.limits->upper)) {
+        const char* unit = joint.type == urdf::Joint::PRISMATIC ? " m" : " rad";
+        return Status::Error("joint " + Quoted(name) + " position " + FormatNumber(position) +
+                             unit + " is outside its limits [" + FormatNumber(joint.limits->lower) +
+                             ", " + FormatNumber(joint.limits->upper) + "]");
+      }
+    }
+    return Status::Ok();
+  }
+
+  static bool IsWeldable(int type) {
+    return type == urdf::Joint::REVOLUTE || type == urdf::Joint::CONTINUOUS ||
+           type == urdf::Joint::PRISMATIC;
+  }
+
+  // The child frame of a welded joint in its joint frame: a turn about the
+  // axis, or a slide along it.
+  Pose JointMotion(const urdf::Joint& joint, JointInfo* info, LoadedModel* loaded) const {
+    if (joint.type == urdf::Joint::FIXED) return Pose::Identity();
+    const auto given = options_.joint_positions.find(joint.name);
+    const double position = given == options_.joint_positions.end() ? 0.0 : given->second;
+    info->position = position;
+    loaded->warnings.push_back("joint " + Quoted(joint.name) + " is " + JointTypeName(joint.type) +
+                               "; welded at " + FormatNumber(position) +
+                               " (movable joints are not simulated yet)");
+    Vec3 axis(joint.axis.x, joint.axis.y, joint.axis.z);
+    if (!(axis.norm() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();  // URDF's default axis
+    axis.normalize();
+    if (joint.type == urdf::Joint::PRISMATIC) return Pose{axis * position, Quat::Identity()};
+    return Pose{Vec3::Zero(), Quat(Eigen::AngleAxisd(position, axis))};
+  }
+
+  // Adds `root` and, through their (welded) joints, all links below it, in
   // depth-first order with an explicit stack: a chain of thousands of links
-  // must not overflow the call stack.
+  // must not overflow the call stack. A joint is recorded when its child is
+  // visited, so the joints come in the depth-first order of their links.
   Status AddLinks(const urdf::Link& root, LoadedModel* loaded,
                   std::vector<MassProperties>* parts_in_root) {
-    std::vector<std::pair<const urdf::Link*, Pose>> pending = {{&root, Pose::Identity()}};
+    struct Pending {
+      const urdf::Link* link;
+      Pose root_from_link;
+      std::optional<JointInfo> joint;  // the joint to the link, none for the root
+    };
+    std::vector<Pending> pending;
+    pending.push_back({&root, Pose::Identity(), std::nullopt});
     while (!pending.empty()) {
-      const auto [link, root_from_link] = pending.back();
+      Pending next = std::move(pending.back());
       pending.pop_back();
-      if (Status status = AddLink(*link, root_from_link, loaded, parts_in_root); !status.ok()) {
+      if (next.joint) loaded->joints.push_back(std::move(*next.joint));
+      const urdf::Link& link = *next.link;
+      if (Status status = AddLink(link, next.root_from_link, loaded, parts_in_root);
+          !status.ok()) {
         return status;
       }
       // Pushed in reverse, so the first child is visited next.
-      for (auto joint = link->child_joints.rbegin(); joint != link->child_joints.rend(); ++joint) {
+      for (auto joint = link.child_joints.rbegin(); joint != link.child_joints.rend(); ++joint) {
         urdf::LinkConstSharedPtr child;
-        for (const urdf::LinkSharedPtr& candidate : link->child_links) {
+        for (const urdf::LinkSharedPtr& candidate : link.child_links) {
           if (candidate->name == (*joint)->child_link_name) child = candidate;
         }
         if (child == nullptr) {
           return Status::Error("joint " + Quoted((*joint)->name) + " has no child link");
         }
-        pending.emplace_back(child.get(),
-                             root_from_link * ToPose((*joint)->parent_to_joint_origin_transform));
+        JointInfo info{(*joint)->name, JointTypeName((*joint)->type), link.name, child->name, 0.0};
+        const Pose root_from_child = next.root_from_link *
+                                     ToPose((*joint)->parent_to_joint_origin_transform) *
+                                     JointMotion(**joint, &info, loaded);
+        pending.push_back({child.get(), root_from_child, std::move(info)});
       }
     }
     return Status::Ok();
@@ -272,7 +338,8 @@ class ModelBuilder {
   // Adds the shapes and the mass of one link.
   Status AddLink(const urdf::Link& link, const Pose& root_from_link, LoadedModel* loaded,
                  std::vector<MassProperties>* parts_in_root) {
-    loaded->links.push_back(LinkFrame{link.name, root_from_link});
+    const std::size_t link_index = loaded->links.size();
+    loaded->links.push_back(LinkFrame{link.name, root_from_link, 0.0});
     const auto friction = friction_.find(link.name);
 
     std::vector<MassProperties> geometry_parts_in_link;
@@ -301,12 +368,14 @@ class ModelBuilder {
     if (link.inertial != nullptr) {
       Result<MassProperties> inertial = InertialMassProperties(link);
       if (!inertial.ok()) return inertial.status();
+      loaded->links[link_index].mass = inertial->mass;
       parts_in_root->push_back(physics::TransformMassProperties(*inertial, root_from_link));
     } else if (!geometry_parts_in_link.empty()) {
       // Overlapping collision elements count twice; a URDF that needs exact
       // mass properties for overlapping geometry states its <inertial>.
-      parts_in_root->push_back(physics::TransformMassProperties(
-          physics::CombineMassProperties(geometry_parts_in_link), root_from_link));
+      const MassProperties from_geometry = physics::CombineMassProperties(geometry_parts_in_link);
+      loaded->links[link_index].mass = from_geometry.mass;
+      parts_in_root->push_back(physics::TransformMassProperties(from_geometry, root_from_link));
       if (!loaded->is_static) {
         loaded->warnings.push_back("link " + Quoted(link.name) +
                                    " has no <inertial>; mass computed from its collision "

@@ -111,7 +111,34 @@ Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request
   spec.is_static = request.is_static;
   spec.friction = request.friction;
   spec.restitution = request.restitution;
+  if (request.joint_positions.size() != request.joint_names.size()) {
+    return Result<ModelSpec>::Error(
+        "joint_positions has " + std::to_string(request.joint_positions.size()) + " values for " +
+        std::to_string(request.joint_names.size()) + " joint_names");
+  }
+  for (std::size_t i = 0; i < request.joint_names.size(); ++i) {
+    const std::string& name = request.joint_names[i];
+    if (!spec.joint_positions.emplace(name, request.joint_positions[i]).second) {
+      return Result<ModelSpec>::Error("joint_names[" + std::to_string(i) + "] '" + name +
+                                      "' is given twice");
+    }
+  }
   return spec;
+}
+
+void ModelPropertiesToMsg(const Model& model, rigid_body_sim::GetModelProperties::Response* msg) {
+  msg->root_link = model.links.front().link_name;
+  for (const io::LinkFrame& link : model.links) {
+    msg->link_names.push_back(link.link_name);
+    msg->link_masses.push_back(link.mass);
+  }
+  msg->mass = model.mass;
+  for (const io::JointInfo& joint : model.joints) {
+    msg->joint_names.push_back(joint.name);
+    msg->joint_types.push_back(joint.type);
+    msg->joint_positions.push_back(joint.position);
+  }
+  msg->is_static = model.is_static;
 }
 
 geometry_msgs::Vector3 VectorToMsg(const Vec3& vector) {
@@ -161,11 +188,10 @@ geometry_msgs::TransformStamped TransformToMsg(const Pose& parent_from_child,
 }
 
 ros::Time SimTimeToRos(double sim_time) {
-  // ros::Time throws beyond 2^32 - 1 s ("Time is out of dual 32-bit range");
-  // a stamp is clamped instead, and NaN becomes 0.
-  constexpr double kMaxRosSeconds = 4294967295.0;
+  // ros::Time throws beyond its unsigned 32-bit seconds; a sim time outside
+  // that range (or NaN) must not take the node down, so it is clamped.
   if (!(sim_time > 0.0)) return ros::Time(0);
-  if (sim_time >= kMaxRosSeconds) return ros::TIME_MAX;
+  if (sim_time >= ros::TIME_MAX.toSec()) return ros::TIME_MAX;
   return ros::Time(sim_time);
 }
 
@@ -292,6 +318,36 @@ visualization_msgs::MarkerArray ContactMarkers(const std::vector<physics::Contac
     array.markers.push_back(std::move(marker));
   }
   return array;
+}
+
+LiveSettings LiveSettingsFromConfig(const rigid_body_sim::PhysicsConfig& config) {
+  LiveSettings settings;
+  settings.gravity = Vec3(config.gravity_x, config.gravity_y, config.gravity_z);
+  settings.time_step = config.time_step;
+  settings.real_time_factor = config.real_time_factor;
+  settings.publish_rate = config.publish_rate;
+  settings.defaults.friction = config.default_friction;
+  settings.defaults.restitution = config.default_restitution;
+  settings.velocity_iterations = config.solver_velocity_iterations;
+  settings.position_iterations = config.solver_position_iterations;
+  settings.sleep_linear_velocity = config.sleep_linear_velocity;
+  settings.sleep_angular_velocity = config.sleep_angular_velocity;
+  return settings;
+}
+
+void LiveSettingsToConfig(const LiveSettings& settings, rigid_body_sim::PhysicsConfig* config) {
+  config->gravity_x = settings.gravity.x();
+  config->gravity_y = settings.gravity.y();
+  config->gravity_z = settings.gravity.z();
+  config->time_step = settings.time_step;
+  config->real_time_factor = settings.real_time_factor;
+  config->publish_rate = settings.publish_rate;
+  config->default_friction = settings.defaults.friction;
+  config->default_restitution = settings.defaults.restitution;
+  config->solver_velocity_iterations = settings.velocity_iterations;
+  config->solver_position_iterations = settings.position_iterations;
+  config->sleep_linear_velocity = settings.sleep_linear_velocity;
+  config->sleep_angular_velocity = settings.sleep_angular_velocity;
 }
 
 }  // namespace rigid_body_sim::node

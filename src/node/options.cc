@@ -1,6 +1,7 @@
 #include "rigid_body_sim/node/options.h"
 
 #include <cmath>
+#include <map>
 #include <set>
 #include <type_traits>
 #include <variant>
@@ -82,13 +83,27 @@ Status ReadParam(const ros::NodeHandle& node, const std::string& name, Reader re
   return reader(value, "parameter " + shown, out);
 }
 
+// `joints: {elbow: 0.5, ...}`: initial positions of movable joints, rad or m.
+Status ReadJoints(XmlRpc::XmlRpcValue& value, const std::string& what,
+                  std::map<std::string, double>* out) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    return Status::Error(what + " must be a dictionary {joint: position}");
+  }
+  for (auto& [name, position] : value) {
+    if (!IsNumber(position)) return Status::Error(what + "." + name + " must be a number");
+    (*out)[name] = ToDouble(position);
+  }
+  return Status::Ok();
+}
+
 Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
   const std::string what = "~models[" + std::to_string(index) + "]";
   if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     return Status::Error(what + " must be a dictionary");
   }
-  static const std::set<std::string> kKeys = {"name",  "urdf",      "urdf_path", "pose",
-                                              "twist", "is_static", "friction",  "restitution"};
+  static const std::set<std::string> kKeys = {"name",     "urdf",        "urdf_path",
+                                              "pose",     "twist",       "is_static",
+                                              "friction", "restitution", "joints"};
   for (auto& [key, unused] : entry) {
     if (kKeys.count(key) == 0) return Status::Error(what + " has an unknown field '" + key + "'");
   }
@@ -102,7 +117,8 @@ Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
         read_field("urdf_path", ReadString, &spec->urdf_path),
         read_field("is_static", ReadBool, &spec->is_static),
         read_field("friction", ReadDouble, &spec->friction),
-        read_field("restitution", ReadDouble, &spec->restitution)}) {
+        read_field("restitution", ReadDouble, &spec->restitution),
+        read_field("joints", ReadJoints, &spec->joint_positions)}) {
     if (!status.ok()) return status;
   }
   std::vector<double> values;
@@ -134,6 +150,88 @@ physics::Quat QuatFromRollPitchYaw(double roll, double pitch, double yaw) {
   return physics::Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()) *
                        Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
                        Eigen::AngleAxisd(roll, Vec3::UnitX()));
+}
+
+LiveSettings LiveSettingsOf(const NodeOptions& options) {
+  LiveSettings live;
+  live.gravity = options.world.gravity;
+  live.time_step = options.world.time_step;
+  live.real_time_factor = options.real_time_factor;
+  live.publish_rate = options.publish_rate;
+  live.defaults = options.defaults;
+  live.velocity_iterations = options.world.solver.velocity_iterations;
+  live.position_iterations = options.world.solver.position_iterations;
+  live.sleep_linear_velocity = options.world.sleep.linear_velocity;
+  live.sleep_angular_velocity = options.world.sleep.angular_velocity;
+  return live;
+}
+
+physics::WorldSettings WithLiveSettings(physics::WorldSettings world,
+                                        const LiveSettings& settings) {
+  world.gravity = settings.gravity;
+  world.time_step = settings.time_step;
+  world.solver.velocity_iterations = settings.velocity_iterations;
+  world.solver.position_iterations = settings.position_iterations;
+  world.sleep.linear_velocity = settings.sleep_linear_velocity;
+  world.sleep.angular_velocity = settings.sleep_angular_velocity;
+  return world;
+}
+
+namespace {
+
+// `value` in [low, high], else an error naming it with its unit and range.
+Status CheckRange(const std::string& name, double value, double low, double high,
+                  const std::string& unit) {
+  if (value >= low && value <= high) return Status::Ok();  // false for NaN
+  const std::string shown_unit = unit.empty() ? "" : " " + unit;
+  return Status::Error(name + " " + FormatNumber(value) + shown_unit + " is outside [" +
+                       FormatNumber(low) + ", " + FormatNumber(high) + "]" + shown_unit);
+}
+
+}  // namespace
+
+Status ValidateLiveSettings(const LiveSettings& settings, const std::string& prefix) {
+  const char* axes[] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    if (Status status = CheckRange(prefix + "gravity." + axes[i], settings.gravity[i], -kMaxGravity,
+                                   kMaxGravity, "m/s^2");
+        !status.ok()) {
+      return status;
+    }
+  }
+  for (const Status& status : {
+           CheckRange(prefix + "time_step", settings.time_step, kMinTimeStep, kMaxTimeStep, "s"),
+           ValidateRealTimeFactor(settings.real_time_factor, prefix + "real_time_factor"),
+           CheckRange(prefix + "publish_rate", settings.publish_rate, kMinPublishRate,
+                      kMaxPublishRate, "Hz"),
+           CheckRange(prefix + "default_friction", settings.defaults.friction, 0.0, kMaxFriction,
+                      ""),
+           CheckRange(prefix + "default_restitution", settings.defaults.restitution, 0.0, 1.0, ""),
+           CheckRange(prefix + "solver/velocity_iterations", settings.velocity_iterations, 1,
+                      kMaxIterations, ""),
+           CheckRange(prefix + "solver/position_iterations", settings.position_iterations, 0,
+                      kMaxIterations, ""),
+           CheckRange(prefix + "sleep/linear_velocity", settings.sleep_linear_velocity, 0.0,
+                      kMaxSleepVelocity, "m/s"),
+           CheckRange(prefix + "sleep/angular_velocity", settings.sleep_angular_velocity, 0.0,
+                      kMaxSleepVelocity, "rad/s"),
+       }) {
+    if (!status.ok()) return status;
+  }
+  return Status::Ok();
+}
+
+std::vector<std::string> LiveSettingsWarnings(const LiveSettings& settings,
+                                              const std::string& prefix) {
+  std::vector<std::string> warnings;
+  if (settings.time_step > kCoarseTimeStep) {
+    warnings.push_back(prefix + "time_step " + FormatNumber(settings.time_step) +
+                       " s is above 1/30 s: contacts and fast bodies are resolved coarsely" +
+                       (settings.time_step == kMaxTimeStep
+                            ? " (it is the maximum; dynamic_reconfigure clamps larger values to it)"
+                            : ""));
+  }
+  return warnings;
 }
 
 Status ValidateNodeOptions(const NodeOptions& options) {
@@ -171,9 +269,8 @@ Status ValidateNodeOptions(const NodeOptions& options) {
         "~continuous_fraction, ~solver, ~sleep): " +
         status.message());
   }
-  if (!(options.publish_rate > 0.0) || !std::isfinite(options.publish_rate)) {
-    return Status::Error("~publish_rate " + FormatNumber(options.publish_rate) +
-                         " Hz must be positive");
+  if (Status status = ValidateLiveSettings(LiveSettingsOf(options), "~"); !status.ok()) {
+    return status;
   }
   const auto check_friction = [](double value, const std::string& name) {
     return value >= 0.0 && std::isfinite(value)
@@ -187,9 +284,7 @@ Status ValidateNodeOptions(const NodeOptions& options) {
   };
   for (const Status& status :
        {check_friction(options.ground_friction, "~ground_friction"),
-        check_friction(options.defaults.friction, "~default_friction"),
-        check_restitution(options.ground_restitution, "~ground_restitution"),
-        check_restitution(options.defaults.restitution, "~default_restitution")}) {
+        check_restitution(options.ground_restitution, "~ground_restitution")}) {
     if (!status.ok()) return status;
   }
   if (!(options.default_density > 0.0) || !std::isfinite(options.default_density)) {

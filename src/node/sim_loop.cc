@@ -33,7 +33,10 @@ void SimNode::StepLocked() {
   wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(),
                                  [](const ActiveWrench& w) { return w.remaining_steps <= 0; }),
                   wrenches_.end());
+  const Clock::time_point start = Clock::now();
   world_.Step();
+  diagnostics_->RecordStep(std::chrono::duration<double>(Clock::now() - start).count(),
+                           world_.last_step_profile());
   ++steps_;
   if (!world_.non_finite_bodies().empty()) ReportFrozenLocked();
 }
@@ -59,31 +62,31 @@ void SimNode::ReanchorLocked() {
 }
 
 void SimNode::StepLoop() {
-  const auto publish_period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / options_.publish_rate));
   const auto clock_period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(kClockPeriodSeconds));
   const auto status_period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(options_.status_period));
-  Clock::time_point next_publish = Clock::now();
   Clock::time_point next_clock = Clock::now();
   Clock::time_point next_status = Clock::now() + status_period;
+  const auto diagnostics_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(diagnostics_->period()));
+  Clock::time_point next_diagnostics = Clock::now() + diagnostics_period;
   for (;;) {
     Outbox outbox;
     try {
       std::unique_lock<std::mutex> lock(mutex_);
       if (shutdown_) return;
       if (paused_) {
-        wake_.wait_until(lock, next_publish, [this] { return shutdown_ || !paused_; });
+        wake_.wait_until(lock, next_publish_, [this] { return shutdown_ || !paused_; });
         if (shutdown_) return;
-      } else if (real_time_factor_ > 0.0) {
+      } else if (live_.real_time_factor > 0.0) {
         // Real-time pacing: the next step is due when the wall clock has
         // caught up with sim time / real_time_factor.
         const auto due = anchor_wall_ +
                          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                             (world_.time() - anchor_sim_) / real_time_factor_));
+                             (world_.time() - anchor_sim_) / live_.real_time_factor));
         if (Clock::now() < due) {
-          const auto wake_at = std::min(due, next_publish);
+          const auto wake_at = std::min(due, next_publish_);
           const auto anchor = anchor_wall_;
           wake_.wait_until(lock, wake_at,
                            [&] { return shutdown_ || paused_ || anchor_wall_ != anchor; });
@@ -96,9 +99,11 @@ void SimNode::StepLoop() {
         StepLocked();
       }
       const Clock::time_point now = Clock::now();
-      if (now >= next_publish) {
+      if (now >= next_publish_) {
         FillPeriodicLocked(&outbox);
-        next_publish = std::max(next_publish + publish_period, now);
+        const auto publish_period = std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double>(1.0 / live_.publish_rate));
+        next_publish_ = std::max(next_publish_ + publish_period, now);
       } else if (options_.use_sim_time && now >= next_clock && world_.time() > 0.0) {
         outbox.clock = world_.time();
       }
@@ -106,6 +111,11 @@ void SimNode::StepLoop() {
       if (now >= next_status) {
         LogStatusLocked(now);
         next_status = now + status_period;
+      }
+      if (now >= next_diagnostics) {
+        CloseDiagnosticsWindowLocked(now);
+        outbox.diagnostics = true;
+        next_diagnostics = now + diagnostics_period;
       }
     } catch (const std::exception& error) {
       // Stepping on would likely throw again at once; pausing keeps the
@@ -124,6 +134,17 @@ void SimNode::StepLoop() {
     // cannot starve them.
     while (waiting_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
   }
+}
+
+void SimNode::CloseDiagnosticsWindowLocked(Clock::time_point now) {
+  WorldSnapshot snapshot;
+  snapshot.sim_time = world_.time();
+  snapshot.target_rtf = live_.real_time_factor;
+  snapshot.paused = paused_;
+  snapshot.bodies = registry_.size();
+  snapshot.awake = world_.AwakeBodyCount();
+  snapshot.contacts = world_.contacts().size();
+  diagnostics_->CloseWindow(snapshot, now);
 }
 
 void SimNode::LogStatusLocked(Clock::time_point now) {

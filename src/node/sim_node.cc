@@ -41,7 +41,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       private_node_(std::move(private_node)),
       world_(options_.world),
       paused_(options_.paused),
-      real_time_factor_(options_.real_time_factor) {
+      live_(LiveSettingsOf(options_)) {
   load_options_.default_density = options_.default_density;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
   load_options_.max_links = options_.max_links_per_model;
@@ -58,6 +58,9 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
     return io::CachedMeshHull(path, scale, hull, mesh_limits);
   };
   load_options_.resolver = ResolveRosUri;
+  // A robot_description with movable joints spawns as one rigid body until
+  // joints are simulated; its joints keep their initial positions.
+  load_options_.weld_movable_joints = true;
 }
 
 SimNode::~SimNode() {
@@ -112,8 +115,8 @@ ros::ServiceServer SimNode::Advertise(const char* name,
 }
 
 Status SimNode::Start() {
-  tf_publisher_ = node_.advertise<tf2_msgs::TFMessage>(names::kTfTopic, 100);
-  tf_static_publisher_ = node_.advertise<tf2_msgs::TFMessage>(names::kTfStaticTopic, 1, true);
+  tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  static_broadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
   if (options_.use_sim_time) {
     clock_publisher_ = node_.advertise<rosgraph_msgs::Clock>(names::kClockTopic, 10);
   }
@@ -126,6 +129,8 @@ Status SimNode::Start() {
       names::kBodyMarkersTopic, 100, [this](const ros::SingleSubscriberPublisher& publisher) {
         OnBodyMarkersSubscriber(publisher);
       });
+
+  diagnostics_ = std::make_unique<SimDiagnostics>(node_, private_node_);
 
   if (options_.ground_plane) {
     physics::BodyDef ground;
@@ -149,10 +154,34 @@ Status SimNode::Start() {
     }
   }
 
+  AdvertiseServices();
+
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ReanchorLocked();
+    next_publish_ = Clock::now();
+    // The frames spawned so far went out with the current stamp already.
+    last_periodic_time_ = world_.time();
+    status_wall_ = Clock::now();
+    status_sim_ = world_.time();
+  }
+  StartReconfigure();
+  loop_thread_ = std::thread([this] { StepLoop(); });
+  ROS_INFO("rigid_body_sim: %zu models, time step %g s, real-time factor %g%s, world frame '%s'",
+           options_.models.size(), live_.time_step, live_.real_time_factor,
+           options_.paused ? ", paused" : "", options_.world_frame.c_str());
+  return Status::Ok();
+}
+
+void SimNode::AdvertiseServices() {
   using Self = SimNode;
   services_.push_back(Advertise(names::kSpawnService, &Self::OnSpawn));
   services_.push_back(Advertise(names::kDeleteService, &Self::OnDelete));
-  services_.push_back(Advertise(names::kResetService, &Self::OnReset));
+  services_.push_back(Advertise(names::kResetService, &Self::OnResetSimulation));
+  services_.push_back(Advertise(names::kResetSimulationService, &Self::OnResetSimulation));
+  services_.push_back(Advertise(names::kResetWorldService, &Self::OnResetWorld));
+  services_.push_back(Advertise(names::kGetWorldPropertiesService, &Self::OnGetWorldProperties));
+  services_.push_back(Advertise(names::kGetModelPropertiesService, &Self::OnGetModelProperties));
   services_.push_back(Advertise(names::kSetPausedService, &Self::OnSetPaused));
   services_.push_back(Advertise(names::kStepService, &Self::OnStep));
   services_.push_back(Advertise(names::kCancelStepService, &Self::OnCancelStep));
@@ -161,35 +190,24 @@ Status SimNode::Start() {
   services_.push_back(Advertise(names::kApplyWrenchService, &Self::OnApplyWrench));
   services_.push_back(Advertise(names::kGetPhysicsService, &Self::OnGetPhysics));
   services_.push_back(Advertise(names::kSetPhysicsService, &Self::OnSetPhysics));
-
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ReanchorLocked();
-    // The frames spawned so far went out with the current stamp already.
-    last_periodic_time_ = world_.time();
-    status_wall_ = Clock::now();
-    status_sim_ = world_.time();
-  }
-  loop_thread_ = std::thread([this] { StepLoop(); });
-  ROS_INFO("rigid_body_sim: %zu models, time step %g s, real-time factor %g%s, world frame '%s'",
-           options_.models.size(), options_.world.time_step, options_.real_time_factor,
-           options_.paused ? ", paused" : "", options_.world_frame.c_str());
-  return Status::Ok();
 }
 
 Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
-  if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, load_options_);
+  io::UrdfLoadOptions options = load_options_;
+  options.joint_positions = spec.joint_positions;
+  if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, options);
   if (spec.urdf_path.empty()) {
     return Result<io::LoadedModel>::Error("neither urdf nor urdf_path is given");
   }
   Result<std::string> path = ResolveRosUri(spec.urdf_path);
   if (!path.ok()) return path.status();
-  return io::LoadUrdfFile(*path, load_options_);
+  return io::LoadUrdfFile(*path, options);
 }
 
 Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
   using FramesResult = Result<std::vector<std::string>>;
   if (Status status = ValidateModelName(spec.name); !status.ok()) return status;
+  MaterialDefaults defaults;
   {
     // Early refusal of a taken name spares loading the model; the name is
     // checked again when the body is added.
@@ -197,10 +215,11 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     if (registry_.Find(spec.name) != nullptr) {
       return FramesResult::Error("a model named '" + spec.name + "' already exists");
     }
+    defaults = live_.defaults;
   }
   Result<io::LoadedModel> loaded = LoadModel(spec);
   if (!loaded.ok()) return loaded.status();
-  Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, options_.defaults);
+  Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, defaults);
   if (!def.ok()) return def.status();
 
   Outbox outbox;
@@ -217,6 +236,8 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     model.body = *body;
     model.is_static = def->is_static;
     model.links = loaded->links;
+    model.joints = loaded->joints;
+    model.mass = def->is_static ? 0.0 : def->mass_properties.mass;
     for (const io::LoadedShape& shape : loaded->shapes)
       model.shape_links.push_back(shape.link_name);
     model.spawn_state =

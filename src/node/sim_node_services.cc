@@ -97,40 +97,6 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
   return true;
 }
 
-bool SimNode::OnReset(std_srvs::Trigger::Request& /*request*/,
-                      std_srvs::Trigger::Response& response) {
-  Outbox outbox;
-  {
-    std::unique_lock<std::mutex> lock = LockWorld();
-    for (const auto& [name, model] : registry_.models()) {
-      const FrameState& state = model.spawn_state;
-      const Status status = world_.SetState(model.body, state.world_from_frame,
-                                            state.linear_velocity, state.angular_velocity);
-      assert(status.ok());
-    }
-    world_.Restart();
-    wrenches_.clear();
-    frozen_models_.clear();
-    last_periodic_time_ = -1.0;
-    ReanchorLocked();
-    status_wall_ = Clock::now();
-    status_sim_ = 0.0;
-    outbox.tf_static = StaticTfLocked();
-    FillPeriodicLocked(&outbox);
-    {
-      std::lock_guard<std::mutex> clock_lock(clock_mutex_);
-      last_clock_ = 0.0;
-    }
-    ++reset_count_;
-  }
-  wake_.notify_all();
-  Publish(std::move(outbox));
-  response.success = true;
-  response.message = "reset: every model at its spawn state, sim time 0";
-  ROS_INFO("%s", response.message.c_str());
-  return true;
-}
-
 bool SimNode::OnSetPaused(std_srvs::SetBool::Request& request,
                           std_srvs::SetBool::Response& response) {
   {
@@ -307,9 +273,9 @@ bool SimNode::OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
 bool SimNode::OnGetPhysics(rigid_body_sim::GetPhysics::Request& /*request*/,
                            rigid_body_sim::GetPhysics::Response& response) {
   std::unique_lock<std::mutex> lock = LockWorld();
-  response.gravity = VectorToMsg(world_.settings().gravity);
-  response.time_step = world_.settings().time_step;
-  response.real_time_factor = real_time_factor_;
+  response.gravity = VectorToMsg(live_.gravity);
+  response.time_step = live_.time_step;
+  response.real_time_factor = live_.real_time_factor;
   return true;
 }
 
@@ -317,30 +283,30 @@ bool SimNode::OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
                            rigid_body_sim::SetPhysics::Response& response) {
   const char* service = names::kSetPhysicsService;
   Result<Vec3> gravity = VectorFromMsg(request.gravity, "gravity");
-  if (!gravity.ok()) return Fail(response, gravity.message(), service);
-  for (const Status& status :
-       {ValidateGravity(*gravity, "gravity"), ValidateTimeStep(request.time_step, "time_step"),
-        ValidateRealTimeFactor(request.real_time_factor, "real_time_factor")}) {
-    if (!status.ok()) return Fail(response, status.message(), service);
-  }
-  if (request.time_step > kWarnTimeStep) {
-    ROS_WARN("~set_physics: time_step %g s is above %g s: contacts and fast bodies will be coarse",
-             request.time_step, kWarnTimeStep);
-  }
+  if (!request.keep_gravity && !gravity.ok()) return Fail(response, gravity.message(), service);
+  std::vector<std::string> warnings;
   {
     std::unique_lock<std::mutex> lock = LockWorld();
-    physics::WorldSettings settings = world_.settings();
-    settings.gravity = *gravity;
-    settings.time_step = request.time_step;
-    if (Status status = world_.SetSettings(settings); !status.ok()) {
+    LiveSettings settings = live_;
+    if (!request.keep_gravity) settings.gravity = *gravity;
+    if (request.time_step != 0.0) settings.time_step = request.time_step;
+    if (!(request.real_time_factor < 0.0)) settings.real_time_factor = request.real_time_factor;
+    if (Status status = ValidateLiveSettings(settings, ""); !status.ok()) {
       return Fail(response, status.message(), service);
     }
-    real_time_factor_ = request.real_time_factor;
-    ReanchorLocked();
+    if (Status status = ApplyLiveSettingsLocked(settings); !status.ok()) {
+      return Fail(response, status.message(), service);
+    }
+    warnings = LiveSettingsWarnings(settings, "");
   }
   wake_.notify_all();
+  PushReconfigureConfig();
   response.success = true;
   response.message = "physics set";
+  for (const std::string& warning : warnings) {
+    ROS_WARN("~%s: %s", service, warning.c_str());
+    response.message += "; warning: " + warning;
+  }
   return true;
 }
 

@@ -18,10 +18,14 @@ FrameState SimNode::RootStateLocked(const Model& model) const {
                     world_.GetAngularVelocity(model.body)};
 }
 
+ros::Time SimNode::StampLocked() const {
+  return options_.use_sim_time ? SimTimeToRos(world_.time()) : ros::Time::now();
+}
+
 tf2_msgs::TFMessage SimNode::ModelTfLocked(const Model& model) const {
   tf2_msgs::TFMessage tf;
   const FrameState root = RootStateLocked(model);
-  const ros::Time stamp = SimTimeToRos(world_.time());
+  const ros::Time stamp = StampLocked();
   for (const io::LinkFrame& link : model.links) {
     tf.transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
                                            options_.world_frame,
@@ -41,10 +45,22 @@ tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
   return tf;
 }
 
+void SimNode::FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const {
+  for (const auto& [name, model] : registry_.models()) {
+    if (model.is_static) continue;
+    const FrameState root = RootStateLocked(model);
+    for (const io::LinkFrame& link : model.links) {
+      tf->transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
+                                              options_.world_frame, FrameName(name, link.link_name),
+                                              stamp));
+    }
+  }
+}
+
 void SimNode::FillPeriodicLocked(Outbox* outbox) {
   outbox->reset_count = reset_count_;
   const double sim_time = world_.time();
-  const ros::Time stamp = SimTimeToRos(sim_time);
+  const ros::Time stamp = StampLocked();
 
   rigid_body_sim::ModelStates& states = outbox->states.emplace();
   states.header.stamp = stamp;
@@ -60,22 +76,12 @@ void SimNode::FillPeriodicLocked(Outbox* outbox) {
     }
   }
   states.frozen.assign(frozen_models_.begin(), frozen_models_.end());
-  // tf2 drops a transform whose stamp it already holds, so tf and contacts
-  // go out only when sim time moved.
-  if (sim_time == last_periodic_time_) return;
+  // tf2 drops a transform whose stamp it already holds, so under sim time
+  // tf goes out only when sim time moved; contacts always only then.
+  const bool sim_time_moved = sim_time != last_periodic_time_;
+  if (sim_time_moved || !options_.use_sim_time) FillTfLocked(stamp, &outbox->tf.emplace());
+  if (!sim_time_moved) return;
   last_periodic_time_ = sim_time;
-
-  tf2_msgs::TFMessage& tf = outbox->tf.emplace();
-  tf.transforms.reserve(states.name.size());
-  for (const auto& [name, model] : registry_.models()) {
-    if (model.is_static) continue;
-    const FrameState root = RootStateLocked(model);
-    for (const io::LinkFrame& link : model.links) {
-      tf.transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
-                                             options_.world_frame, FrameName(name, link.link_name),
-                                             stamp));
-    }
-  }
 
   // Every colliding contact since the last message, and the resting and
   // separating contacts of the last step (its colliding ones are in the log).
@@ -106,7 +112,13 @@ void SimNode::FillPeriodicLocked(Outbox* outbox) {
 }
 
 void SimNode::Publish(Outbox outbox) {
-  if (outbox.tf_static) tf_static_publisher_.publish(*outbox.tf_static);
+  if (outbox.tf_static) {
+    std::lock_guard<std::mutex> lock(static_mutex_);
+    // The new broadcaster is made before the old one goes, so the topic
+    // stays advertised and its latched message is replaced, not dropped.
+    static_broadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
+    static_broadcaster_->sendTransform(outbox.tf_static->transforms);
+  }
   if (outbox.tf && !outbox.tf->transforms.empty()) {
     // A snapshot built before a step service's one may reach here after it;
     // listeners would take the older poses as the latest, so it is dropped.
@@ -118,7 +130,7 @@ void SimNode::Publish(Outbox outbox) {
     const ros::Time stamp = outbox.tf->transforms.front().header.stamp;
     if (outbox.reset_count == tf_reset_count_ &&
         (outbox.tf_is_new_frame || stamp >= last_tf_stamp_)) {
-      tf_publisher_.publish(*outbox.tf);
+      tf_broadcaster_->sendTransform(outbox.tf->transforms);
       if (!outbox.tf_is_new_frame) last_tf_stamp_ = stamp;
     }
   }
@@ -128,6 +140,7 @@ void SimNode::Publish(Outbox outbox) {
     contact_markers_publisher_.publish(*outbox.contact_markers);
   }
   if (outbox.body_markers) body_markers_publisher_.publish(*outbox.body_markers);
+  if (outbox.diagnostics) diagnostics_->Publish();
   if (outbox.clock && options_.use_sim_time) {
     std::lock_guard<std::mutex> lock(clock_mutex_);
     if (*outbox.clock > last_clock_) {

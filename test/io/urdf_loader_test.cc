@@ -434,5 +434,78 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// An arm: box 'base' (2 kg), an elbow turning about z at 1 m up x, a 0.5 kg
+// sphere link 'forearm', and a slider along y to a 0.25 kg link 'tip'.
+std::string ArmUrdf() {
+  return "<robot name=\"arm\">"
+         "<link name=\"base\"><inertial><mass value=\"2\"/><inertia ixx=\"1\" iyy=\"1\" "
+         "izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry>"
+         "<box size=\"1 1 1\"/></geometry></collision></link>"
+         "<link name=\"forearm\"><inertial><mass value=\"0.5\"/><inertia ixx=\"0.1\" "
+         "iyy=\"0.1\" izz=\"0.1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision>"
+         "<origin xyz=\"1 0 0\"/><geometry><sphere radius=\"0.2\"/></geometry></collision>"
+         "</link>"
+         "<link name=\"tip\"><inertial><mass value=\"0.25\"/><inertia ixx=\"0.01\" "
+         "iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>"
+         "<joint name=\"elbow\" type=\"revolute\"><parent link=\"base\"/>"
+         "<child link=\"forearm\"/><origin xyz=\"1 0 0\"/><axis xyz=\"0 0 1\"/>"
+         "<limit lower=\"-1\" upper=\"2\" effort=\"1\" velocity=\"1\"/></joint>"
+         "<joint name=\"slider\" type=\"prismatic\"><parent link=\"forearm\"/>"
+         "<child link=\"tip\"/><origin xyz=\"1 0 0\"/><axis xyz=\"0 1 0\"/>"
+         "<limit lower=\"0\" upper=\"0.5\" effort=\"1\" velocity=\"1\"/></joint>"
+         "</robot>";
+}
+
+TEST(UrdfLoaderTest, MovableJointsAreWeldedAtTheirGivenPositions) {
+  UrdfLoadOptions options;
+  options.weld_movable_joints = true;
+  options.joint_positions = {{"elbow", kPi / 2.0}, {"slider", 0.5}};
+  const Result<LoadedModel> model = LoadUrdfString(ArmUrdf(), options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  ASSERT_EQ(model->links.size(), 3u);
+  EXPECT_EQ(model->links[0].mass, 2.0);
+  EXPECT_EQ(model->links[1].mass, 0.5);
+  EXPECT_EQ(model->links[2].mass, 0.25);
+  EXPECT_EQ(model->mass_properties.mass, 2.75);
+  // The forearm frame sits at the elbow, turned a quarter turn about z.
+  const Pose& forearm = model->links[1].root_from_link;
+  EXPECT_TRUE(forearm.translation.isApprox(Vec3(1, 0, 0), 1e-15));
+  EXPECT_TRUE((forearm.rotation * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-15));
+  // The slider's origin is 1 m along the turned forearm's x (world +y), and it
+  // slides 0.5 m along the forearm's y (world -x).
+  EXPECT_TRUE(model->links[2].root_from_link.translation.isApprox(Vec3(0.5, 1, 0), 1e-15));
+  ASSERT_EQ(model->joints.size(), 2u);
+  EXPECT_EQ(model->joints[0].name, "elbow");
+  EXPECT_EQ(model->joints[0].type, "revolute");
+  EXPECT_EQ(model->joints[0].parent_link, "base");
+  EXPECT_EQ(model->joints[0].child_link, "forearm");
+  EXPECT_EQ(model->joints[0].position, kPi / 2.0);
+  EXPECT_EQ(model->joints[1].position, 0.5);
+  // The sphere collision of the forearm is 1 m along its x: at (1, 1, 0).
+  const auto& sphere = model->shapes[1].shape.body_from_shape;
+  EXPECT_TRUE(sphere.translation.isApprox(Vec3(1, 1, 0), 1e-15));
+  EXPECT_EQ(model->warnings.size(), 2u);
+}
+
+TEST(UrdfLoaderTest, BadJointPositionsAreRefusedByName) {
+  UrdfLoadOptions options;
+  options.weld_movable_joints = true;
+  options.joint_positions = {{"elbow", 2.5}};
+  Result<LoadedModel> model = LoadUrdfString(ArmUrdf(), options);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.message(), "joint 'elbow' position 2.5 rad is outside its limits [-1, 2]");
+  options.joint_positions = {{"wrist", 0.0}};
+  model = LoadUrdfString(ArmUrdf(), options);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.message(),
+            "joint 'wrist' is not a movable joint of the model; movable: 'elbow', 'slider'");
+  // Without welding, the same model is refused as before.
+  options.weld_movable_joints = false;
+  options.joint_positions.clear();
+  model = LoadUrdfString(ArmUrdf(), options);
+  ASSERT_FALSE(model.ok());
+  EXPECT_NE(model.message().find("joint 'elbow' is revolute"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::io

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 
 namespace rigid_body_sim::node {
@@ -67,6 +68,32 @@ TEST(MsgConversionTest, HugeQuaternionIsRefusedWithItsNorm) {
   const auto large = PoseFromMsg(MsgPose(0, 0, 0, 0, 0, 0, 1e8), "pose");
   ASSERT_TRUE(large.ok()) << large.message();
   EXPECT_EQ(large->rotation.z(), 1.0);
+}
+
+TEST(MsgConversionTest, SimTimeToRosClampsInsteadOfThrowing) {
+  EXPECT_EQ(SimTimeToRos(1.25), ros::Time(1, 250000000));
+  EXPECT_EQ(SimTimeToRos(-3.0), ros::Time(0));
+  EXPECT_EQ(SimTimeToRos(std::nan("")), ros::Time(0));
+  // ros::Time(5e9) would throw std::runtime_error.
+  EXPECT_EQ(SimTimeToRos(5e9), ros::TIME_MAX);
+  EXPECT_EQ(SimTimeToRos(std::numeric_limits<double>::infinity()), ros::TIME_MAX);
+}
+
+TEST(MsgConversionTest, SpawnJointFieldsPairUpWithoutRepeats) {
+  rigid_body_sim::Spawn::Request request;
+  request.name = "arm";
+  request.pose.orientation.w = 1.0;
+  request.joint_names = {"elbow", "wrist"};
+  request.joint_positions = {0.5, -0.25};
+  const auto spec = ModelSpecFromMsg(request);
+  ASSERT_TRUE(spec.ok()) << spec.message();
+  EXPECT_EQ(spec->joint_positions,
+            (std::map<std::string, double>{{"elbow", 0.5}, {"wrist", -0.25}}));
+  request.joint_positions = {0.5};
+  EXPECT_EQ(ModelSpecFromMsg(request).message(), "joint_positions has 1 values for 2 joint_names");
+  request.joint_names = {"elbow", "elbow"};
+  request.joint_positions = {0.5, 0.6};
+  EXPECT_EQ(ModelSpecFromMsg(request).message(), "joint_names[1] 'elbow' is given twice");
 }
 
 TEST(MsgConversionTest, PoseAndTwistRoundTrip) {

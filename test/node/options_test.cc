@@ -28,6 +28,31 @@ TEST(OptionsTest, BadValuesAreNamed) {
   EXPECT_NE(ValidateNodeOptions(options).message().find("leading slash"), std::string::npos);
 }
 
+TEST(OptionsTest, LiveRangesHoldAtStartUpAndWarnAboveAThirtiethOfASecond) {
+  NodeOptions options;
+  options.world.time_step = 0.5;
+  EXPECT_EQ(ValidateNodeOptions(options).message(), "~time_step 0.5 s is outside [1e-05, 0.1] s");
+  options = NodeOptions();
+  options.world.gravity.y() = 2000.0;
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~gravity.y 2000 m/s^2 is outside [-1000, 1000] m/s^2");
+  LiveSettings live = LiveSettingsOf(NodeOptions());
+  EXPECT_TRUE(ValidateLiveSettings(live, "").ok());
+  EXPECT_TRUE(LiveSettingsWarnings(live, "").empty());
+  live.time_step = 0.05;
+  ASSERT_TRUE(ValidateLiveSettings(live, "").ok());
+  ASSERT_EQ(LiveSettingsWarnings(live, "").size(), 1u);
+  EXPECT_EQ(LiveSettingsWarnings(live, "")[0],
+            "time_step 0.05 s is above 1/30 s: contacts and fast bodies are resolved coarsely");
+  live.velocity_iterations = 0;
+  EXPECT_EQ(ValidateLiveSettings(live, "").message(),
+            "solver/velocity_iterations 0 is outside [1, 1000]");
+  live = LiveSettingsOf(NodeOptions());
+  live.sleep_angular_velocity = std::nan("");
+  EXPECT_EQ(ValidateLiveSettings(live, "").message(),
+            "sleep/angular_velocity nan rad/s is outside [0, 10] rad/s");
+}
+
 TEST(OptionsTest, ModelListNeedsUniqueNamesAndASource) {
   NodeOptions options;
   ModelSpec spec;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +48,14 @@ struct UrdfLoadOptions {
   // Maps package:// and file:// URIs of meshes to local paths. When empty,
   // ResolveFileUri is used, so package:// URIs are an error.
   UriResolver resolver;
+  // Movable joints are not simulated yet. When true, revolute, continuous and
+  // prismatic joints are welded at their position in `joint_positions` (rad
+  // or m; 0 for joints not listed), each with a warning; when false they are
+  // refused. Floating and planar joints are always refused.
+  bool weld_movable_joints = false;
+  // By joint name; every name must be a weldable movable joint of the model
+  // and every value within the joint's limits, or the load fails.
+  std::map<std::string, double> joint_positions;
 };
 
 // One collision element of the model.
@@ -60,6 +69,16 @@ struct LoadedShape {
 struct LinkFrame {
   std::string link_name;
   physics::Pose root_from_link;
+  double mass = 0.0;  // kg: the <inertial> mass, else from geometry at the default density
+};
+
+// A joint of the model, all of them welded into the one body.
+struct JointInfo {
+  std::string name;
+  std::string type;  // URDF type: fixed, revolute, continuous or prismatic
+  std::string parent_link;
+  std::string child_link;
+  double position = 0.0;  // rad or m, the welded position; 0 for fixed joints
 };
 
 // One rigid body made of all links of a URDF model joined by fixed joints.
@@ -73,13 +92,15 @@ struct LoadedModel {
   physics::MassProperties mass_properties;  // root-link frame; validated unless static
   std::vector<LoadedShape> shapes;          // root-link frame
   std::vector<LinkFrame> links;             // every link of the body, root first
+  std::vector<JointInfo> joints;            // every joint but the one to `world`, tree order
   std::vector<std::string> warnings;        // e.g. inertia computed from geometry
 };
 
 // Parses a URDF document. Fails, naming the element, on malformed XML,
-// unsupported or movable joints, invalid <inertial>, unreadable or degenerate
-// meshes, sizes outside the limits above, more links than
-// options.max_links, or a model without collision geometry. Relative mesh paths are
+// unsupported or (unless welded, see UrdfLoadOptions) movable joints, bad
+// joint positions, invalid <inertial>, unreadable or degenerate meshes, sizes
+// outside the limits above, more links than options.max_links, or a model
+// without collision geometry. Relative mesh paths are
 // taken relative to the working directory.
 physics::Result<LoadedModel> LoadUrdfString(const std::string& xml,
                                             const UrdfLoadOptions& options = {});

@@ -33,6 +33,9 @@ struct ModelSpec {
   bool is_static = false;
   double friction = -1.0;     // >= 0 overrides every shape; < 0: URDF or the default
   double restitution = -1.0;  // >= 0 overrides every shape; < 0: the default
+  // rad or m by movable joint name; they are welded there (not simulated
+  // yet). The loader checks names and limits.
+  std::map<std::string, double> joint_positions;
 };
 
 // Materials of shapes the spec and the URDF leave open.
@@ -64,7 +67,9 @@ struct Model {
   std::string name;
   physics::BodyId body;
   bool is_static = false;
-  std::vector<io::LinkFrame> links;      // every link of the body, root first
+  std::vector<io::LinkFrame> links;      // every link of the body, root first, with masses
+  std::vector<io::JointInfo> joints;     // every joint but one to 'world'
+  double mass = 0.0;                     // kg, of the body; 0 when static
   std::vector<std::string> shape_links;  // per shape of the body, the link it came from
   FrameState spawn_state;                // of the root link, restored by a reset
 };

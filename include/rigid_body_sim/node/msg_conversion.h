@@ -17,8 +17,11 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "rigid_body_sim/Contact.h"
+#include "rigid_body_sim/GetModelProperties.h"
+#include "rigid_body_sim/PhysicsConfig.h"
 #include "rigid_body_sim/Spawn.h"
 #include "rigid_body_sim/node/model_registry.h"
+#include "rigid_body_sim/node/options.h"
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/shape.h"
@@ -40,7 +43,8 @@ physics::Result<physics::Pose> PoseFromMsg(const geometry_msgs::Pose& msg,
                                            const std::string& field);
 physics::Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
                                               const geometry_msgs::Twist& twist);
-// The spawn request as a spec; checks only the pose and twist.
+// The spawn request as a spec; checks the pose, the twist and that the joint
+// fields pair up without repeats (the loader checks names and limits).
 physics::Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request);
 
 // --- core to messages ---------------------------------------------------------
@@ -54,11 +58,21 @@ geometry_msgs::TransformStamped TransformToMsg(const physics::Pose& parent_from_
                                                const std::string& parent_frame,
                                                const std::string& child_frame,
                                                const ros::Time& stamp);
-// Sim time (s) as a ROS time stamp, clamped to [0, ros::TIME_MAX]; never throws.
+// Sim time (s) as a ROS time stamp: 0 for negative or NaN, ros::TIME_MAX
+// beyond its range (about 136 years), never an exception.
 ros::Time SimTimeToRos(double sim_time);
 
 rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
                                      const std::string& body_a, const std::string& body_b);
+
+// Links with masses, joints and whether it is static (no success/message).
+void ModelPropertiesToMsg(const Model& model, rigid_body_sim::GetModelProperties::Response* msg);
+
+// --- dynamic_reconfigure (cfg/Physics.cfg) -----------------------------------
+
+// Unchecked; ValidateLiveSettings checks.
+LiveSettings LiveSettingsFromConfig(const rigid_body_sim::PhysicsConfig& config);
+void LiveSettingsToConfig(const LiveSettings& settings, rigid_body_sim::PhysicsConfig* config);
 
 // --- markers ----------------------------------------------------------------
 

@@ -19,6 +19,10 @@ inline constexpr char kApplyWrenchService[] = "apply_wrench";
 inline constexpr char kGetPhysicsService[] = "get_physics";
 inline constexpr char kSetPhysicsService[] = "set_physics";
 inline constexpr char kCancelStepService[] = "cancel_step";
+inline constexpr char kGetWorldPropertiesService[] = "get_world_properties";
+inline constexpr char kGetModelPropertiesService[] = "get_model_properties";
+inline constexpr char kResetWorldService[] = "reset_world";
+inline constexpr char kResetSimulationService[] = "reset_simulation";
 
 // Topics (~).
 inline constexpr char kContactsTopic[] = "contacts";
@@ -26,7 +30,7 @@ inline constexpr char kStatesTopic[] = "states";
 inline constexpr char kContactMarkersTopic[] = "contact_markers";
 inline constexpr char kBodyMarkersTopic[] = "body_markers";
 
-// Global topics.
+// Global topics (tf2_ros's broadcasters publish /tf and /tf_static).
 inline constexpr char kTfTopic[] = "/tf";
 inline constexpr char kTfStaticTopic[] = "/tf_static";
 inline constexpr char kClockTopic[] = "/clock";

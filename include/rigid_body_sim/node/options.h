@@ -59,9 +59,46 @@ struct NodeOptions {
   // ~models: spawned at start-up, in order; each entry has the fields of
   // Spawn (name, urdf, urdf_path, is_static, friction, restitution), pose:
   // [x, y, z, roll, pitch, yaw] (m, rad; default all 0) and twist:
-  // [vx, vy, vz, wx, wy, wz] (m/s, rad/s; default all 0).
+  // [vx, vy, vz, wx, wy, wz] (m/s, rad/s; default all 0) and joints:
+  // {name: position} (rad or m, as Spawn's joint fields).
   std::vector<ModelSpec> models;
 };
+
+// What ~set_physics and dynamic_reconfigure (cfg/Physics.cfg) may change while
+// the node runs. The same ranges hold at start-up; the .cfg states them too.
+struct LiveSettings {
+  physics::Vec3 gravity = physics::Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame
+  double time_step = 1.0 / 240.0;                          // s
+  double real_time_factor = 1.0;                           // 0 = as fast as possible
+  double publish_rate = 50.0;                              // Hz
+  MaterialDefaults defaults;
+  int velocity_iterations = 20;  // solver sweeps
+  int position_iterations = 6;
+  double sleep_linear_velocity = 0.05;  // m/s
+  double sleep_angular_velocity = 0.1;  // rad/s
+};
+
+// Ranges of the live settings; gravity, time step, real-time factor and
+// friction share request_validation.h's.
+inline constexpr double kCoarseTimeStep = kWarnTimeStep;  // s; longer steps log a warning
+inline constexpr double kMinPublishRate = 0.1;            // Hz
+inline constexpr double kMaxPublishRate = 1000.0;         // Hz
+inline constexpr int kMaxIterations = 1000;
+inline constexpr double kMaxSleepVelocity = 10.0;  // m/s and rad/s
+
+LiveSettings LiveSettingsOf(const NodeOptions& options);
+
+// Fails on the first value out of range, naming it (`prefix` + field), its
+// value and the range.
+physics::Status ValidateLiveSettings(const LiveSettings& settings, const std::string& prefix);
+
+// Valid but doubtful values, each a message naming it: a time step above
+// kCoarseTimeStep.
+std::vector<std::string> LiveSettingsWarnings(const LiveSettings& settings,
+                                              const std::string& prefix);
+
+// The world settings with the live ones of `settings` put in.
+physics::WorldSettings WithLiveSettings(physics::WorldSettings world, const LiveSettings& settings);
 
 // Checks ranges and the model list (valid unique names, a URDF source each).
 physics::Status ValidateNodeOptions(const NodeOptions& options);

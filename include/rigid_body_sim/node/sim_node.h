@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -15,18 +16,25 @@
 #include <thread>
 #include <vector>
 
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <boost/thread/recursive_mutex.hpp>
 
 #include "rigid_body_sim/ApplyWrench.h"
 #include "rigid_body_sim/Contacts.h"
 #include "rigid_body_sim/Delete.h"
+#include "rigid_body_sim/GetModelProperties.h"
 #include "rigid_body_sim/GetPhysics.h"
 #include "rigid_body_sim/GetState.h"
+#include "rigid_body_sim/GetWorldProperties.h"
 #include "rigid_body_sim/ModelStates.h"
+#include "rigid_body_sim/PhysicsConfig.h"
 #include "rigid_body_sim/SetPhysics.h"
 #include "rigid_body_sim/SetState.h"
 #include "rigid_body_sim/Spawn.h"
@@ -34,6 +42,7 @@
 #include "rigid_body_sim/io/urdf_loader.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
+#include "rigid_body_sim/node/sim_diagnostics.h"
 #include "rigid_body_sim/physics/world.h"
 
 namespace rigid_body_sim::node {
@@ -74,10 +83,13 @@ class SimNode {
     std::optional<visualization_msgs::MarkerArray> contact_markers;
     std::optional<visualization_msgs::MarkerArray> body_markers;
     std::optional<double> clock;    // s of sim time
+    bool diagnostics = false;       // a diagnostics window closed
     bool tf_is_new_frame = false;   // tf holds only the frames of a new model
     std::uint64_t reset_count = 0;  // resets before the messages were built
   };
   using Clock = std::chrono::steady_clock;
+
+  void AdvertiseServices();
 
   // Locks the world mutex, telling the step loop to let the caller in first.
   std::unique_lock<std::mutex> LockWorld();
@@ -89,7 +101,17 @@ class SimNode {
   bool OnSpawn(rigid_body_sim::Spawn::Request& request, rigid_body_sim::Spawn::Response& response);
   bool OnDelete(rigid_body_sim::Delete::Request& request,
                 rigid_body_sim::Delete::Response& response);
-  bool OnReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  // World services (sim_world_services.cc): introspection and the resets.
+  bool OnResetSimulation(std_srvs::Trigger::Request& request,
+                         std_srvs::Trigger::Response& response);
+  bool OnResetWorld(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool OnGetWorldProperties(rigid_body_sim::GetWorldProperties::Request& request,
+                            rigid_body_sim::GetWorldProperties::Response& response);
+  bool OnGetModelProperties(rigid_body_sim::GetModelProperties::Request& request,
+                            rigid_body_sim::GetModelProperties::Response& response);
+  // Every model back to its spawn state, wrenches dropped; sim time back to 0
+  // unless keep_time. Returns the reply's message.
+  std::string Reset(bool keep_time);
   bool OnSetPaused(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool OnStep(rigid_body_sim::Step::Request& request, rigid_body_sim::Step::Response& response);
   bool OnGetState(rigid_body_sim::GetState::Request& request,
@@ -111,6 +133,16 @@ class SimNode {
                                bool (SimNode::*method)(Request& request, Response& response));
   void OnBodyMarkersSubscriber(const ros::SingleSubscriberPublisher& publisher);
 
+  // Live parameters (sim_reconfigure.cc). The dynamic_reconfigure server
+  // takes its own mutex, then the world's; nothing takes them the other way
+  // round (PushReconfigureConfig runs without the world lock).
+  void StartReconfigure();
+  void OnReconfigure(rigid_body_sim::PhysicsConfig& config, std::uint32_t level);
+  // Shows the running values in the server (after ~set_physics).
+  void PushReconfigureConfig();
+  // Validated settings into the world and the loop; the caller wakes it.
+  physics::Status ApplyLiveSettingsLocked(const LiveSettings& settings);
+
   void StepLoop();
   // The callers of these hold the mutex.
   void StepLocked();
@@ -118,12 +150,19 @@ class SimNode {
   void ReportFrozenLocked();
   void ReanchorLocked();
   FrameState RootStateLocked(const Model& model) const;
-  // The periodic messages; tf, contacts and the clock only when sim time
-  // moved since they were last built.
+  // The stamp of everything published now: sim time when /use_sim_time is
+  // true (listeners follow our /clock), wall time otherwise, so that tf
+  // listeners never extrapolate.
+  ros::Time StampLocked() const;
+  // The periodic messages; contacts and the clock only when sim time moved
+  // since they were last built, tf too under sim time (tf2 drops a repeated
+  // stamp); under wall time tf goes out every period with a new stamp.
   void FillPeriodicLocked(Outbox* outbox);
+  void FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const;
   tf2_msgs::TFMessage ModelTfLocked(const Model& model) const;
   tf2_msgs::TFMessage StaticTfLocked() const;
   void LogStatusLocked(Clock::time_point now);
+  void CloseDiagnosticsWindowLocked(Clock::time_point now);
 
   void Publish(Outbox outbox);
 
@@ -131,14 +170,21 @@ class SimNode {
   io::UrdfLoadOptions load_options_;
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
-  ros::Publisher tf_publisher_;
-  ros::Publisher tf_static_publisher_;
+  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  // Replaced on every /tf_static message, under static_mutex_: the
+  // broadcaster keeps every frame it was ever given, so a deleted static
+  // model would stay in the latched message of a long-lived one.
+  std::mutex static_mutex_;
+  std::unique_ptr<tf2_ros::StaticTransformBroadcaster> static_broadcaster_;
   ros::Publisher clock_publisher_;
   ros::Publisher states_publisher_;
   ros::Publisher contacts_publisher_;
   ros::Publisher contact_markers_publisher_;
   ros::Publisher body_markers_publisher_;
   std::vector<ros::ServiceServer> services_;
+  std::unique_ptr<SimDiagnostics> diagnostics_;
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<rigid_body_sim::PhysicsConfig>> reconfigure_;
 
   std::mutex mutex_;
   std::condition_variable wake_;  // pause, resume, settings, shutdown
@@ -155,13 +201,15 @@ class SimNode {
   bool step_in_progress_ = false;
   std::string cancel_step_;  // the service that stops the ~step call in progress, if any
   bool shutdown_ = false;
-  double real_time_factor_ = 1.0;
+  LiveSettings live_;                 // what ~set_physics and dynamic_reconfigure change
   double last_periodic_time_ = -1.0;  // sim time of the last tf and contacts
   int contact_marker_count_ = 0;      // contacts drawn in the last contact markers
   std::uint64_t steps_ = 0;
   // Pacing: sim time anchor_sim_ is due at wall time anchor_wall_.
   Clock::time_point anchor_wall_;
   double anchor_sim_ = 0.0;
+  // When the loop next publishes; a new ~publish_rate takes effect at once.
+  Clock::time_point next_publish_;
   Clock::time_point status_wall_;
   double status_sim_ = 0.0;
 
