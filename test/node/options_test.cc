@@ -31,11 +31,13 @@ TEST(OptionsTest, BadValuesAreNamed) {
 TEST(OptionsTest, LiveRangesHoldAtStartUpAndWarnAboveAThirtiethOfASecond) {
   NodeOptions options;
   options.world.time_step = 0.5;
-  EXPECT_EQ(ValidateNodeOptions(options).message(), "~time_step 0.5 s is outside [1e-05, 0.1] s");
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~time_step 0.5 s is outside the allowed range [1e-05, 0.1] s");
   options = NodeOptions();
   options.world.gravity.y() = 2000.0;
   EXPECT_EQ(ValidateNodeOptions(options).message(),
-            "~gravity.y 2000 m/s^2 is outside [-1000, 1000] m/s^2");
+            "~gravity [0, 2000, -9.81] m/s^2 (magnitude 2000.02) is outside the allowed range "
+            "[0, 1000] m/s^2");
   LiveSettings live = LiveSettingsOf(NodeOptions());
   EXPECT_TRUE(ValidateLiveSettings(live, "").ok());
   EXPECT_TRUE(LiveSettingsWarnings(live, "").empty());
