@@ -4,7 +4,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rigid_body_sim::io {
@@ -181,6 +183,57 @@ Status CheckShapeExtents(const Vec3& extents, const std::string& what) {
   return Status::Ok();
 }
 
+namespace {
+
+// The joints must form a tree over the links: no joint from a link to
+// itself, no link with two parent joints, no cycle. urdfdom refuses these
+// too, but only after linking its link and joint objects to each other by
+// shared pointers, which then keep one another alive: a refused model would
+// leak inside the node (urdf_loader_fuzzer found it). Following each link's
+// one parent upwards, a walk that meets a link of its own walk is a cycle.
+Status CheckJointTree(const TiXmlElement& robot) {
+  std::map<std::string, std::pair<std::string, std::string>> parent_of;  // child: joint, parent
+  for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const char* name = joint->Attribute("name");
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const TiXmlElement* child = joint->FirstChildElement("child");
+    const char* parent_link = parent == nullptr ? nullptr : parent->Attribute("link");
+    const char* child_link = child == nullptr ? nullptr : child->Attribute("link");
+    if (name == nullptr || parent_link == nullptr || child_link == nullptr) continue;
+    if (std::string(parent_link) == child_link) {
+      return Status::Error("joint " + Quoted(name) + " joins link " + Quoted(child_link) +
+                           " to itself");
+    }
+    const auto [existing, added] = parent_of.emplace(child_link, std::make_pair(name, parent_link));
+    if (!added) {
+      return Status::Error("link " + Quoted(child_link) + " is the child of two joints, " +
+                           Quoted(existing->second.first) + " and " + Quoted(name));
+    }
+  }
+  std::map<std::string, int> walk_of;  // link: the walk that visited it first
+  int walk = 0;
+  for (const auto& [start, unused] : parent_of) {
+    ++walk;
+    std::string link = start;
+    while (true) {
+      const auto [visited, first_visit] = walk_of.emplace(link, walk);
+      if (!first_visit) {
+        if (visited->second == walk) {
+          return Status::Error("the joints form a cycle through link " + Quoted(link));
+        }
+        break;  // reached a link an earlier walk has checked
+      }
+      const auto parent = parent_of.find(link);
+      if (parent == parent_of.end()) break;
+      link = parent->second.second;
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
   int links = 0;
   for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
@@ -203,7 +256,7 @@ Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& optio
       return status;
     }
   }
-  return Status::Ok();
+  return CheckJointTree(robot);
 }
 
 }  // namespace rigid_body_sim::io

@@ -101,6 +101,29 @@ TEST(UrdfHostileTest, TenThousandLinkChainIsRefusedOrLoadedIteratively) {
 // past the end of the text (heap-buffer-overflow under AddressSanitizer,
 // during a fuzzing run; it ends in the UTF-8 lead byte 0xe7). It is refused
 // by name, and under make test-sanitize read within bounds.
+// Joints that do not form a tree are refused before urdfdom builds its
+// objects (it links them into shared-pointer cycles that leak when it then
+// refuses the model; urdf_loader_fuzzer found the self-joint).
+TEST(UrdfHostileTest, JointsThatDoNotFormATreeAreRefused) {
+  const std::string links =
+      "<link name='a'><collision><geometry><sphere radius='1'/></geometry></collision></link>"
+      "<link name='b'><collision><geometry><sphere radius='1'/></geometry></collision></link>"
+      "<link name='c'><collision><geometry><sphere radius='1'/></geometry></collision></link>";
+  auto joint = [](const std::string& name, const std::string& parent, const std::string& child) {
+    return "<joint name='" + name + "' type='fixed'><parent link='" + parent + "'/><child link='" +
+           child + "'/></joint>";
+  };
+  ExpectRefused(
+      "<robot name='r'>" + links + joint("j", "a", "b") + joint("self", "c", "c") + "</robot>",
+      {"joint 'self'", "link 'c'", "to itself"});
+  ExpectRefused(
+      "<robot name='r'>" + links + joint("j1", "a", "c") + joint("j2", "b", "c") + "</robot>",
+      {"link 'c'", "two joints", "'j1'", "'j2'"});
+  ExpectRefused("<robot name='r'>" + links + joint("j1", "a", "b") + joint("j2", "b", "c") +
+                    joint("j3", "c", "a") + "</robot>",
+                {"cycle"});
+}
+
 TEST(UrdfHostileTest, DocumentEndingInAUtf8LeadByteIsRefused) {
   const Result<LoadedModel> model =
       LoadUrdfFile(std::string(RBS_TEST_DATA_DIR) + "/utf8_lead_byte_at_end.urdf");
