@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "physics/polyhedron_collision.h"
+#include "physics/polyhedron_manifold.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -72,33 +73,6 @@ IncidentPoints CylinderIncident(const Cylinder& cylinder, const Pose& world_from
     points.cap_rim[k] = world_from_cylinder * Vec3(rim + Vec3(0, 0, facing_z));
   }
   return points;
-}
-
-// Closest points of segments p0 p1 and q0 q1: s, t in [0, 1] minimising
-// |p0 + s d1 - q0 - t d2| (Ericson, "Real-Time Collision Detection", 2005,
-// section 5.1.9).
-std::pair<Vec3, Vec3> ClosestPointsOfSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0,
-                                              const Vec3& q1) {
-  const Vec3 d1 = p1 - p0;
-  const Vec3 d2 = q1 - q0;
-  const Vec3 r = p0 - q0;
-  const double a = d1.squaredNorm();
-  const double e = d2.squaredNorm();
-  const double f = d2.dot(r);
-  const double c = d1.dot(r);
-  const double b = d1.dot(d2);
-  const double denominator = a * e - b * b;
-  double s =
-      denominator > 1e-18 * a * e ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
-  double t = (b * s + f) / e;
-  if (t < 0.0) {
-    t = 0.0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1.0) {
-    t = 1.0;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-  return {p0 + s * d1, q0 + t * d2};
 }
 
 // Sutherland and Hodgman (1974): the part of a convex polygon (or segment)
@@ -326,7 +300,10 @@ CylinderAxis BestAxis(const CylinderPair& pair, const WorldCylinder& cylinder,
   for (int e = 0; e < shape.EdgeCount(); ++e) {
     const Vec3& start = polyhedron.vertices[shape.half_edges[2 * e].origin];
     const Vec3& end = polyhedron.vertices[shape.half_edges[2 * e + 1].origin];
-    const auto [on_axis, on_edge] = ClosestPointsOfSegments(axis_start, axis_end, start, end);
+    Vec3 on_axis;
+    Vec3 on_edge;
+    ClosestPointsOfSegments(axis_start, axis_end - axis_start, start, end - start, &on_axis,
+                            &on_edge);
     Vec3 across = cylinder.axis.cross(end - start);
     if (across.norm() > 1e-9 * (end - start).norm()) {
       across.normalize();

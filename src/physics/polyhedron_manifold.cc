@@ -41,31 +41,6 @@ FeatureId MakeFeatureId(const ClipVertex& vertex, const FaceContactInput& input,
   return FeatureId{};
 }
 
-// Closest points of segments p0 + s d1 and q0 + t d2, s, t in [0, 1]:
-// minimise |p0 + s d1 - q0 - t d2|^2; the unconstrained s is clamped, t
-// follows from s and is clamped, and s is recomputed from the clamped t.
-void ClosestPointsOfSegments(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2,
-                             Vec3* on_p, Vec3* on_q) {
-  const Vec3 r = p0 - q0;
-  const double a = d1.squaredNorm();
-  const double e = d2.squaredNorm();
-  const double b = d1.dot(d2);
-  const double c = d1.dot(r);
-  const double f = d2.dot(r);
-  const double denominator = a * e - b * b;
-  double s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
-  double t = (b * s + f) / e;
-  if (t < 0.0) {
-    t = 0.0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1.0) {
-    t = 1.0;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-  *on_p = p0 + s * d1;
-  *on_q = q0 + t * d2;
-}
-
 // The face of `incident` most anti-parallel to the reference normal, given
 // in the incident shape's frame.
 int IncidentFace(const ConvexPolyhedron& incident, const Vec3& normal_in_incident) {
@@ -186,6 +161,28 @@ void ClipToReferenceFace(const FaceContactInput& input, const Vec3& normal,
 }
 
 }  // namespace
+
+void ClosestPointsOfSegments(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2,
+                             Vec3* on_p, Vec3* on_q) {
+  const Vec3 r = p0 - q0;
+  const double a = d1.squaredNorm();
+  const double e = d2.squaredNorm();
+  const double b = d1.dot(d2);
+  const double c = d1.dot(r);
+  const double f = d2.dot(r);
+  const double denominator = a * e - b * b;
+  double s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  double t = (b * s + f) / e;
+  if (t < 0.0) {
+    t = 0.0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1.0) {
+    t = 1.0;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  *on_p = p0 + s * d1;
+  *on_q = q0 + t * d2;
+}
 
 // Face contact (Sutherland and Hodgman 1974 clipping): the incident face is
 // the face of the other shape most anti-parallel to the reference normal n;

@@ -26,6 +26,14 @@ struct FaceContactInput {
 // produced it, so its id is the same whenever the configuration is.
 bool BuildFaceContact(const FaceContactInput& input, ContactManifold* manifold);
 
+// Closest points of segments p0 + s d1 and q0 + t d2, s, t in [0, 1]:
+// minimise |p0 + s d1 - q0 - t d2|^2; the unconstrained s is clamped, t
+// follows from s and is clamped, and s is recomputed from the clamped t
+// (Ericson, "Real-Time Collision Detection", 2005, section 5.1.9). Both
+// segments must have a positive length.
+void ClosestPointsOfSegments(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2,
+                             Vec3* on_p, Vec3* on_q);
+
 // Baraff's edge/edge contact: one point midway between the closest points
 // of the two edges.
 bool BuildEdgeContact(const PolyhedronPair& pair, int edge_a, int edge_b, double separation,

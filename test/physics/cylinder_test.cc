@@ -195,24 +195,39 @@ BodyId AddCylinder(World* world, const Pose& world_from_body, const Material& ma
   return world->CreateBody(def).value();
 }
 
+// A static 1 m thick ramp tilted by theta about y, centred at `centre`: its
+// top face has normal (sin, 0, cos) and falls along (cos, 0, -sin).
+struct Ramp {
+  Vec3 top_centre;  // m, the middle of its top face
+  Vec3 normal;
+  Vec3 downhill;
+  Quat tilt;
+};
+
+Ramp AddRamp(World* world, double theta, double length, const Vec3& centre, double friction) {
+  const Quat tilt = AxisAngle(theta, Vec3::UnitY());
+  BoxSpec ramp;
+  ramp.size = Vec3(length, 4.0, 1.0);
+  ramp.is_static = true;
+  ramp.world_from_body = Pose{centre, tilt};
+  ramp.material = MakeMaterial(friction, 0.0);
+  AddBox(world, ramp);
+  const Vec3 normal = tilt * Vec3::UnitZ();
+  return Ramp{centre + 0.5 * normal, normal, tilt * Vec3::UnitX(), tilt};
+}
+
 // A solid cylinder rolling without slipping down a slope: its centre
 // accelerates at a = g sin(theta) / (1 + I / (m r^2)) = (2/3) g sin(theta),
 // so it travels a t^2 / 2 from rest. Rolling needs mu >= tan(theta) / 3.
 TEST(CylinderRollingTest, RollsDownATenDegreeRampAtTwoThirdsGSinTheta) {
   const double theta = 10 * kDegree;
   World world;
-  const Quat tilt = AxisAngle(theta, Vec3::UnitY());
-  BoxSpec ramp;
-  ramp.size = Vec3(40.0, 4.0, 1.0);
-  ramp.is_static = true;
-  ramp.world_from_body = Pose{Vec3(0, 0, 5.0), tilt};
-  ramp.material = MakeMaterial(0.5, 0.0);
-  AddBox(&world, ramp);
-  const Vec3 normal = tilt * Vec3::UnitZ();
-  const Vec3 downhill = tilt * Vec3::UnitX();
+  const Ramp ramp = AddRamp(&world, theta, 40.0, Vec3(0, 0, 5.0), 0.5);
+  const Vec3& normal = ramp.normal;
+  const Vec3& downhill = ramp.downhill;
   const double radius = 0.1;
-  const Pose start{ramp.world_from_body.translation + normal * (0.5 + radius) - 10.0 * downhill,
-                   tilt * AxisAngle(kPi / 2, Vec3::UnitX())};
+  const Pose start{ramp.top_centre + normal * radius - 10.0 * downhill,
+                   ramp.tilt * AxisAngle(kPi / 2, Vec3::UnitX())};
   const BodyId cylinder = AddCylinder(&world, start, MakeMaterial(0.5, 0.0), radius, 0.15, 2.0);
   const double t = 2.0;
   const int steps = static_cast<int>(std::lround(t / world.settings().time_step));
@@ -252,15 +267,8 @@ TEST(CylinderRollingTest, RollsOnFlatGroundWithoutLosingSpeed) {
 TEST(CylinderStandingTest, StandsOnItsCapOnATwentyDegreeSlope) {
   const double theta = 20 * kDegree;
   World world;
-  const Quat tilt = AxisAngle(theta, Vec3::UnitY());
-  BoxSpec ramp;
-  ramp.size = Vec3(10.0, 4.0, 1.0);
-  ramp.is_static = true;
-  ramp.world_from_body = Pose{Vec3(0, 0, 2.0), tilt};
-  ramp.material = MakeMaterial(0.8, 0.0);
-  AddBox(&world, ramp);
-  const Vec3 normal = tilt * Vec3::UnitZ();
-  const Pose start{ramp.world_from_body.translation + normal * (0.5 + 0.1), tilt};
+  const Ramp ramp = AddRamp(&world, theta, 10.0, Vec3(0, 0, 2.0), 0.8);
+  const Pose start{ramp.top_centre + ramp.normal * 0.1, ramp.tilt};
   const BodyId cylinder = AddCylinder(&world, start, MakeMaterial(0.8, 0.0), 0.1, 0.1, 1.0);
   double drift = 0.0;
   for (int step = 0; step < 240 * 5; ++step) {
