@@ -154,6 +154,9 @@ Status SimNode::Start() {
     }
   }
 
+  // Before the services: ~set_physics updates the reconfigure server, so
+  // it must exist by the time the first call can arrive.
+  StartReconfigure();
   AdvertiseServices();
 
   {
@@ -165,7 +168,6 @@ Status SimNode::Start() {
     status_wall_ = Clock::now();
     status_sim_ = world_.time();
   }
-  StartReconfigure();
   loop_thread_ = std::thread([this] { StepLoop(); });
   ROS_INFO("rigid_body_sim: %zu models, time step %g s, real-time factor %g%s, world frame '%s'",
            options_.models.size(), live_.time_step, live_.real_time_factor,
