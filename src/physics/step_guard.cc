@@ -87,13 +87,7 @@ void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal
     v->setZero();
   }
   body.UpdateDerived();
-  body.disabled = true;
-  body.awake = false;
-  woke_since_prune_ = true;
-  if (body.has_proxy) {
-    broad_phase_.RemoveProxy(static_cast<int>(index));
-    body.has_proxy = false;
-  }
+  DisableBody(index);
   contact_cache_.RemoveBody(index);
   const auto touches = [index](const ContactReport& contact) {
     return contact.body_a.index == index || contact.body_b.index == index;
@@ -104,11 +98,6 @@ void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal
   // The sleeping pairs' reports at the front of contacts_ are made afresh.
   sleeping_reports_version_ = ~std::uint64_t{0};
   sleeping_report_count_ = 0;
-  const BodyId id{index, body.generation};
-  if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
-      non_finite_bodies_.end()) {
-    non_finite_bodies_.push_back(id);
-  }
 }
 
 }  // namespace rigid_body_sim::physics

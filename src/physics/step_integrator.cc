@@ -305,15 +305,26 @@ void WorldImpl::DisableNonFiniteBodies() {
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
     if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
-    body.disabled = true;
-    body.awake = false;
-    woke_since_prune_ = true;
-    if (body.has_proxy) {
-      broad_phase_.RemoveProxy(static_cast<int>(i));
-      body.has_proxy = false;
-    }
     // Its cached pairs are no longer seen from the next step on, and go.
-    non_finite_bodies_.push_back(BodyId{i, body.generation});
+    DisableBody(i);
+  }
+}
+
+// Out of the simulation until it is given a finite state: asleep, out of
+// the broad phase, and reported once in non_finite_bodies_.
+void WorldImpl::DisableBody(std::uint32_t index) {
+  Body& body = bodies_[index];
+  body.disabled = true;
+  body.awake = false;
+  woke_since_prune_ = true;
+  if (body.has_proxy) {
+    broad_phase_.RemoveProxy(static_cast<int>(index));
+    body.has_proxy = false;
+  }
+  const BodyId id{index, body.generation};
+  if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
+      non_finite_bodies_.end()) {
+    non_finite_bodies_.push_back(id);
   }
 }
 

@@ -99,6 +99,7 @@ class WorldImpl {
   void UpdateSleep(double dt);
   bool UpdateSpeedingUp(double dt, Body* body) const;
   void DisableNonFiniteBodies();
+  void DisableBody(std::uint32_t index);
   // The step guard (step_guard.cc), around stages 1-5: bodies whose state
   // or pending force would overflow a step are frozen before it, bodies
   // whose state is not finite after it go back to their pose at its start.
