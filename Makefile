@@ -54,6 +54,11 @@ ws-links:
 	  [ "$$name" = build ] || ln -sfn $$entry $(WS)/src/rigid_body_sim/$$name; \
 	done
 	@find $(WS)/src/rigid_body_sim -maxdepth 1 -xtype l -delete
+	@# catkin writes the environment ctest runs the tests in when it first
+	@# configures, and puts only directories that exist then on PYTHONPATH:
+	@# without this one, a fresh clone's Python tests cannot import the
+	@# package's generated messages.
+	@mkdir -p $(WS)/devel/lib/python3/dist-packages
 
 build: deps ws-links
 	@echo "[build] catkin_make in $(WS)"
