@@ -1,0 +1,307 @@
+// Articulations against closed forms and conservation laws: the pendulum's
+// elliptic-integral period, the double pendulum's energy, a tilted prismatic
+// joint's acceleration, an inelastic joint limit, a 30-link chain with a
+// heavy tip that may not stretch, the servo's and the motor's steady states,
+// and a link resting on the ground.
+#include <cmath>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "scene.h"
+
+namespace rigid_body_sim::physics::testing {
+namespace {
+
+constexpr double kG = 9.81;
+constexpr double kDt = 1.0 / 240.0;
+
+// A slender rod of mass m and length l along -z of its link frame, with a
+// sphere of radius `radius` at its end for contact.
+LinkDef Rod(double mass, double length, double radius = 0.0) {
+  LinkDef link;
+  link.mass_properties.mass = mass;
+  link.mass_properties.center_of_mass = Vec3(0, 0, -length);
+  const double i = mass * 1e-4;  // nearly a point mass at the end
+  link.mass_properties.inertia_about_com = Mat3::Identity() * i;
+  if (radius > 0.0) {
+    ShapeDef shape;
+    shape.geometry = Sphere{radius};
+    shape.body_from_shape.translation = Vec3(0, 0, -length);
+    link.shapes.push_back(shape);
+  }
+  return link;
+}
+
+LinkDef Anchor() {
+  LinkDef link;
+  link.mass_properties.mass = 1.0;
+  link.mass_properties.inertia_about_com = Mat3::Identity() * 0.01;
+  return link;
+}
+
+// Joint k: revolute about y, at the end of the parent rod of `length`
+// (at the base's origin for the first).
+JointDef Hinge(int child, double parent_length, double position) {
+  JointDef joint;
+  joint.name = "j" + std::to_string(child);
+  joint.type = JointType::kContinuous;
+  joint.parent_link = child - 1;
+  joint.child_link = child;
+  joint.parent_from_joint.translation = Vec3(0, 0, -parent_length);
+  joint.axis = Vec3::UnitY();
+  joint.position = position;
+  return joint;
+}
+
+World MakeWorld() {
+  WorldSettings settings;
+  settings.time_step = kDt;
+  settings.gravity = Vec3(0, 0, -kG);
+  return World(settings);
+}
+
+// K(k) = pi / (2 AGM(1, sqrt(1 - k^2))) (Abramowitz and Stegun 1964,
+// 17.6).
+double EllipticK(double k) {
+  double a = 1.0;
+  double b = std::sqrt(1.0 - k * k);
+  for (int i = 0; i < 40; ++i) {
+    const double next = 0.5 * (a + b);
+    b = std::sqrt(a * b);
+    a = next;
+  }
+  return kPi / (2.0 * a);
+}
+
+// The pendulum's period T = 4 sqrt(I_p / (m g l)) K(sin(theta0 / 2)),
+// measured over ten periods from the upward zero crossings of the angle,
+// each placed by linear interpolation between steps.
+TEST(ArticulationTest, PendulumPeriodMatchesTheEllipticIntegral) {
+  for (const double amplitude_degrees : {10.0, 45.0, 90.0}) {
+    SCOPED_TRACE(amplitude_degrees);
+    World world = MakeWorld();
+    const double mass = 1.0;
+    const double length = 1.0;
+    ArticulationDef def;
+    def.fixed_base = true;
+    def.links = {Anchor(), Rod(mass, length)};
+    const double amplitude = amplitude_degrees * kPi / 180.0;
+    def.joints = {Hinge(1, 0.0, amplitude)};
+    const ArticulationId pendulum = world.CreateArticulation(def).value();
+    const double inertia = mass * 1e-4 + mass * length * length;
+    const double expected = 4.0 * std::sqrt(inertia / (mass * kG * length)) *
+                            EllipticK(std::sin(0.5 * amplitude));
+    std::vector<double> crossings;
+    double previous = amplitude;
+    for (int step = 1; crossings.size() < 11 && step < 100000; ++step) {
+      world.Step();
+      const double angle = world.GetJointStates(pendulum)[0].position;
+      if (previous < 0.0 && angle >= 0.0) {
+        crossings.push_back((step - 1 + previous / (previous - angle)) * kDt);
+      }
+      previous = angle;
+    }
+    ASSERT_EQ(crossings.size(), 11u);
+    const double period = (crossings.back() - crossings.front()) / 10.0;
+    EXPECT_NEAR(period / expected, 1.0, 1e-5);
+  }
+}
+
+double TotalEnergy(const World& world, ArticulationId id) {
+  double energy = 0.0;
+  for (const BodyId link : world.ArticulationLinks(id)) {
+    const Body& body = world.GetBody(link);
+    energy += KineticEnergy(body) + body.mass * kG * body.position.z();
+  }
+  return energy;
+}
+
+// Released from horizontal, the undamped double pendulum is chaotic; its
+// energy is conserved. The drift is measured as a share of the energy above
+// the hanging rest.
+TEST(ArticulationTest, DoublePendulumConservesEnergy) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(1.0, 1.0), Rod(1.0, 1.0)};
+  def.joints = {Hinge(1, 0.0, kPi / 2), Hinge(2, 1.0, 0.0)};
+  const ArticulationId pendulum = world.CreateArticulation(def).value();
+  const double rest = -kG * (1.0 + 2.0);  // both masses hanging: z = -1 and -2
+  const double start = TotalEnergy(world, pendulum);
+  double worst = 0.0;
+  for (int step = 0; step < 20 * 240; ++step) {
+    world.Step();
+    worst = std::max(worst, std::abs(TotalEnergy(world, pendulum) - start));
+  }
+  EXPECT_LT(worst / (start - rest), 2e-3);
+}
+
+// A carriage on a prismatic joint tilted theta from the vertical
+// accelerates at g cos(theta) along it.
+TEST(ArticulationTest, TiltedPrismaticAcceleratesAtGCosTheta) {
+  for (const double theta : {0.0, 0.5, 1.2}) {
+    SCOPED_TRACE(theta);
+    World world = MakeWorld();
+    ArticulationDef def;
+    def.fixed_base = true;
+    LinkDef carriage = Anchor();
+    carriage.mass_properties.mass = 3.0;
+    def.links = {Anchor(), carriage};
+    JointDef slide;
+    slide.name = "slide";
+    slide.type = JointType::kPrismatic;
+    slide.axis = Vec3(std::sin(theta), 0.0, -std::cos(theta));
+    def.joints = {slide};
+    const ArticulationId id = world.CreateArticulation(def).value();
+    const int steps = 240;
+    for (int step = 0; step < steps; ++step) world.Step();
+    const double t = steps * kDt;
+    const double expected = 0.5 * kG * std::cos(theta) * t * t;
+    const JointState state = world.GetJointStates(id)[0];
+    EXPECT_NEAR(state.position / expected, 1.0, 1e-4);
+    EXPECT_NEAR(state.velocity / (kG * std::cos(theta) * t), 1.0, 1e-4);
+  }
+}
+
+// Released 90 degrees from its lower limit, with gravity still pressing it
+// there, the arm stops at the limit: no overshoot beyond 1 mrad, no bounce.
+TEST(ArticulationTest, JointLimitStopsWithoutOvershootOrBounce) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(1.0, 1.0)};
+  // The rod hangs at angle 0; gravity turns it toward 0 from either side.
+  // The lower limit at 0.3 rad is reached moving down, and gravity still
+  // presses the rod against it there.
+  constexpr double kLower = 0.3;
+  JointDef hinge = Hinge(1, 0.0, kLower + kPi / 2);
+  hinge.type = JointType::kRevolute;
+  hinge.lower = kLower;
+  hinge.upper = kLower + kPi / 2;
+  def.joints = {hinge};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  double lowest = kPi;
+  bool reached = false;
+  double highest_after = -kPi;
+  for (int step = 0; step < 3 * 240; ++step) {
+    world.Step();
+    const double angle = world.GetJointStates(id)[0].position;
+    lowest = std::min(lowest, angle);
+    if (angle < kLower + 1e-3) reached = true;
+    if (reached) highest_after = std::max(highest_after, angle);
+  }
+  ASSERT_TRUE(reached);
+  EXPECT_GT(lowest, kLower - 1e-3);
+  EXPECT_LT(highest_after, kLower + 1e-3);
+}
+
+double AnchorSeparation(const World& world, ArticulationId id, const ArticulationDef& def) {
+  const std::vector<BodyId> links = world.ArticulationLinks(id);
+  double worst = 0.0;
+  for (const JointDef& joint : def.joints) {
+    const Vec3 from_parent =
+        world.GetPose(links[joint.parent_link]) * joint.parent_from_joint.translation;
+    const Vec3 child_origin = world.GetPose(links[joint.child_link]).translation;
+    worst = std::max(worst, (from_parent - child_origin).norm());
+  }
+  return worst;
+}
+
+// 30 links of 0.1 kg and a 100 kg tip (1000:1), released horizontal and
+// swinging for 10 s: no joint separates, and energy stays (RK4 loses a
+// little; it may not gain).
+TEST(ArticulationTest, HeavyTippedChainNeverStretches) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links.push_back(Anchor());
+  const int count = 30;
+  for (int i = 1; i <= count; ++i) {
+    def.links.push_back(Rod(i == count ? 100.0 : 0.1, 0.1));
+    def.joints.push_back(Hinge(i, i == 1 ? 0.0 : 0.1, i == 1 ? kPi / 2 : 0.0));
+  }
+  const ArticulationId chain = world.CreateArticulation(def).value();
+  const double start = TotalEnergy(world, chain);
+  double worst = 0.0;
+  for (int step = 0; step < 10 * 240; ++step) {
+    world.Step();
+    worst = std::max(worst, AnchorSeparation(world, chain, def));
+  }
+  EXPECT_LT(worst, 1e-6);
+  const double end = TotalEnergy(world, chain);
+  ASSERT_TRUE(std::isfinite(end));
+  EXPECT_LT(end, start + 1e-3 * std::abs(start));
+}
+
+// A position servo holds a horizontal arm against gravity with the spring's
+// steady error tau / k; a velocity motor turns at its commanded speed.
+TEST(ArticulationTest, ServoHoldsWithinTauOverKAndMotorKeepsItsSpeed) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(2.0, 0.5)};
+  JointDef hinge = Hinge(1, 0.0, kPi / 2);
+  hinge.effort_limit = 100.0;
+  def.joints = {hinge};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  ServoGains gains;
+  ASSERT_TRUE(world.SetServoGains(id, gains).ok());
+  JointCommand hold;
+  hold.mode = JointCommandMode::kPosition;
+  hold.position = kPi / 2;
+  ASSERT_TRUE(world.SetJointCommand(id, 0, hold).ok());
+  for (int step = 0; step < 5 * 240; ++step) world.Step();
+  const double gravity_torque = 2.0 * kG * 0.5;  // horizontal: full lever arm
+  const JointState held = world.GetJointStates(id)[0];
+  EXPECT_NEAR(held.position, kPi / 2 - gravity_torque / gains.stiffness, 1e-6);
+  EXPECT_NEAR(held.effort, gravity_torque, 1e-3 * gravity_torque);
+
+  JointCommand turn;
+  turn.mode = JointCommandMode::kVelocity;
+  turn.velocity = 0.5;
+  ASSERT_TRUE(world.SetJointCommand(id, 0, turn).ok());
+  for (int step = 0; step < 120; ++step) world.Step();
+  EXPECT_NEAR(world.GetJointStates(id)[0].velocity, 0.5, 5e-3);
+}
+
+// A floating two-link articulation (a box with a flap) dropped on the
+// ground comes to rest on it at the box's half height, and a refused
+// definition leaves the world unchanged.
+TEST(ArticulationTest, FloatingArticulationRestsOnTheGround) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(0.8, 0.0));
+  ArticulationDef def;
+  def.world_from_base = Translation(0, 0, 0.5);
+  LinkDef body;
+  body.mass_properties = BoxMassProperties(1000.0, Vec3(0.2, 0.2, 0.2));
+  ShapeDef box;
+  box.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3(0.2, 0.2, 0.2)));
+  box.material = MakeMaterial(0.8, 0.0);
+  body.shapes.push_back(box);
+  LinkDef flap;
+  flap.mass_properties = BoxMassProperties(1000.0, Vec3(0.05, 0.05, 0.05));
+  flap.mass_properties.center_of_mass = Vec3(0, 0, 0.05);
+  JointDef hinge;
+  hinge.name = "flap";
+  hinge.type = JointType::kRevolute;
+  hinge.parent_from_joint.translation = Vec3(0, 0, 0.1);
+  hinge.axis = Vec3::UnitY();
+  hinge.lower = -0.1;
+  hinge.upper = 0.1;
+  def.links = {body, flap};
+  def.joints = {hinge};
+  const std::size_t bodies_before = world.BodyCount();
+  ArticulationDef bad = def;
+  bad.joints[0].position = 0.5;  // outside [-0.1, 0.1]
+  EXPECT_FALSE(world.CreateArticulation(bad).ok());
+  EXPECT_EQ(world.BodyCount(), bodies_before);
+  const ArticulationId id = world.CreateArticulation(def).value();
+  for (int step = 0; step < 2 * 240; ++step) world.Step();
+  const Pose base = world.GetPose(world.ArticulationLinks(id)[0]);
+  EXPECT_NEAR(base.translation.z(), 0.1, 1e-3);
+  EXPECT_LT(world.GetLinearVelocity(world.ArticulationLinks(id)[0]).norm(), 1e-2);
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::physics::testing
