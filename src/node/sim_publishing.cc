@@ -13,9 +13,11 @@ namespace rigid_body_sim::node {
 
 using physics::BodyId;
 
-FrameState SimNode::RootStateLocked(const Model& model) const {
-  return FrameState{world_.GetPose(model.body), world_.GetLinearVelocity(model.body),
-                    world_.GetAngularVelocity(model.body)};
+FrameState SimNode::LinkStateLocked(const Model& model, std::size_t link) const {
+  const BodyId body = model.bodies[model.link_body[link]];
+  const FrameState body_state{world_.GetPose(body), world_.GetLinearVelocity(body),
+                              world_.GetAngularVelocity(body)};
+  return LinkStateFromRoot(body_state, model.body_from_link[link]);
 }
 
 ros::Time SimNode::StampLocked() const {
@@ -24,12 +26,11 @@ ros::Time SimNode::StampLocked() const {
 
 tf2_msgs::TFMessage SimNode::ModelTfLocked(const Model& model) const {
   tf2_msgs::TFMessage tf;
-  const FrameState root = RootStateLocked(model);
   const ros::Time stamp = StampLocked();
-  for (const io::LinkFrame& link : model.links) {
-    tf.transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    tf.transforms.push_back(TransformToMsg(LinkStateLocked(model, i).world_from_frame,
                                            options_.world_frame,
-                                           FrameName(model.name, link.link_name), stamp));
+                                           FrameName(model.name, model.links[i].link_name), stamp));
   }
   return tf;
 }
@@ -48,11 +49,10 @@ tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
 void SimNode::FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const {
   for (const auto& [name, model] : registry_.models()) {
     if (model.is_static) continue;
-    const FrameState root = RootStateLocked(model);
-    for (const io::LinkFrame& link : model.links) {
-      tf->transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
-                                              options_.world_frame, FrameName(name, link.link_name),
-                                              stamp));
+    for (std::size_t i = 0; i < model.links.size(); ++i) {
+      tf->transforms.push_back(TransformToMsg(LinkStateLocked(model, i).world_from_frame,
+                                              options_.world_frame,
+                                              FrameName(name, model.links[i].link_name), stamp));
     }
   }
 }
@@ -67,15 +67,15 @@ void SimNode::FillPeriodicLocked(Outbox* outbox) {
   states.header.frame_id = options_.world_frame;
   states.name.reserve(registry_.size());
   for (const auto& [name, model] : registry_.models()) {
-    const FrameState root = RootStateLocked(model);
-    for (const io::LinkFrame& link : model.links) {
-      const FrameState state = LinkStateFromRoot(root, link.root_from_link);
-      states.name.push_back(FrameName(name, link.link_name));
+    for (std::size_t i = 0; i < model.links.size(); ++i) {
+      const FrameState state = LinkStateLocked(model, i);
+      states.name.push_back(FrameName(name, model.links[i].link_name));
       states.pose.push_back(PoseToMsg(state.world_from_frame));
       states.twist.push_back(TwistToMsg(state.linear_velocity, state.angular_velocity));
     }
   }
   states.frozen.assign(frozen_models_.begin(), frozen_models_.end());
+  FillJointStatesLocked(stamp, outbox);
   // tf2 drops a transform whose stamp it already holds, so under sim time
   // tf goes out only when sim time moved; contacts always only then.
   const bool sim_time_moved = sim_time != last_periodic_time_;
@@ -135,6 +135,7 @@ void SimNode::Publish(Outbox outbox) {
     }
   }
   if (outbox.states) states_publisher_.publish(*outbox.states);
+  PublishJointStates(outbox);
   if (outbox.contacts) contacts_publisher_.publish(*outbox.contacts);
   if (outbox.contact_markers && !outbox.contact_markers->markers.empty()) {
     contact_markers_publisher_.publish(*outbox.contact_markers);

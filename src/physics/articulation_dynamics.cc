@@ -100,7 +100,8 @@ void ComputeKinematics(const ArticulationModel& model, const ArticulationState& 
     if (joint.def.type == JointType::kPrismatic) {
       jc.block<3, 1>(0, column) += factor * axis;
     } else {
-      jc.block<3, 1>(0, column) += factor * axis.cross(k->com_world[child] - world_from_joint.translation);
+      jc.block<3, 1>(0, column) +=
+          factor * axis.cross(k->com_world[child] - world_from_joint.translation);
       jc.block<3, 1>(3, column) += factor * axis;
     }
   }

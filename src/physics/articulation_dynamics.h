@@ -19,10 +19,10 @@ namespace rigid_body_sim::physics {
 using JacobianRows = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // linear (3) then angular (3)
 
 struct ArticulationLink {
-  std::uint32_t body = 0;  // the link's Body in the world
-  int parent_joint = -1;   // -1 for the base
-  double mass = 0.0;       // kg
-  Vec3 com_link = Vec3::Zero();        // m, centre of mass in the link frame
+  std::uint32_t body = 0;                // the link's Body in the world
+  int parent_joint = -1;                 // -1 for the base
+  double mass = 0.0;                     // kg
+  Vec3 com_link = Vec3::Zero();          // m, centre of mass in the link frame
   Mat3 inertia_link = Mat3::Identity();  // kg m^2, about the centre of mass, link frame
   Vec3 force = Vec3::Zero();   // N, world, applied over the next step at the centre of mass
   Vec3 torque = Vec3::Zero();  // N m, world
@@ -59,8 +59,8 @@ struct ArticulationModel {
 // Where every link is and how it moves, for one state.
 struct ArticulationKinematics {
   std::vector<Pose> world_from_link;
-  std::vector<Vec3> com_world;      // m
-  std::vector<Mat3> inertia_world;  // kg m^2
+  std::vector<Vec3> com_world;         // m
+  std::vector<Mat3> inertia_world;     // kg m^2
   std::vector<Vec3> linear_velocity;   // m/s, of the centre of mass
   std::vector<Vec3> angular_velocity;  // rad/s
   std::vector<Vec3> joint_axis_world;

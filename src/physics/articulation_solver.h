@@ -33,34 +33,34 @@ namespace rigid_body_sim::physics {
 struct RowSide {
   enum class Kind : std::uint8_t { kNone, kArticulation, kBody };
   Kind kind = Kind::kNone;
-  int slot = -1;              // index of the articulation or body slot
-  Eigen::VectorXd jacobian;   // articulation: J_k over its u
-  Eigen::VectorXd response;   // articulation: M^-1 J_k^T
-  Vec3 linear = Vec3::Zero();   // body: d
-  Vec3 angular = Vec3::Zero();  // body: r x d
+  int slot = -1;                         // index of the articulation or body slot
+  Eigen::VectorXd jacobian;              // articulation: J_k over its u
+  Eigen::VectorXd response;              // articulation: M^-1 J_k^T
+  Vec3 linear = Vec3::Zero();            // body: d
+  Vec3 angular = Vec3::Zero();           // body: r x d
   Vec3 linear_response = Vec3::Zero();   // body: d / m
   Vec3 angular_response = Vec3::Zero();  // body: I^-1 (r x d)
 };
 
 enum class RowKind : std::uint8_t {
-  kBounded,   // lower <= lambda <= upper; v -> target (soft when softness > 0)
-  kNormal,    // lambda >= 0, v >= target, lambda (v - target) = 0
-  kTangent,   // friction, with the next row its pair: |(l_t0, l_t1)| <= mu l_normal
+  kBounded,  // lower <= lambda <= upper; v -> target (soft when softness > 0)
+  kNormal,   // lambda >= 0, v >= target, lambda (v - target) = 0
+  kTangent,  // friction, with the next row its pair: |(l_t0, l_t1)| <= mu l_normal
 };
 
 struct ConstraintRow {
   RowSide a;
   RowSide b;
   RowKind kind = RowKind::kBounded;
-  double target = 0.0;  // velocity units of the row
+  double target = 0.0;                                      // velocity units of the row
   double lower = -std::numeric_limits<double>::infinity();  // impulse
   double upper = std::numeric_limits<double>::infinity();
   // gamma of a soft constraint: v + gamma lambda -> target (Catto 2011,
   // "Soft Constraints", GDC; the constraint force mixing of ODE).
   double softness = 0.0;
-  int normal_row = -1;  // kTangent: its normal row
-  double friction = 0.0;  // kTangent: mu
-  double impulse = 0.0;   // lambda, warm start in, result out
+  int normal_row = -1;     // kTangent: its normal row
+  double friction = 0.0;   // kTangent: mu
+  double impulse = 0.0;    // lambda, warm start in, result out
   bool colliding = false;  // a contact point classified colliding
   // A joint's own row (limit, servo, motor, friction): whose, and the sign
   // its impulse has as the joint's effort.

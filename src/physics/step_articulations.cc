@@ -66,8 +66,8 @@ void WorldImpl::SplitLinkPairs(const std::vector<ShapePairContact*>& pairs) {
   rigid_pairs_.clear();
   link_pairs_.clear();
   for (ShapePairContact* pair : pairs) {
-    const bool link = bodies_[pair->body_a].articulation >= 0 ||
-                      bodies_[pair->body_b].articulation >= 0;
+    const bool link =
+        bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0;
     (link ? link_pairs_ : rigid_pairs_).push_back(pair);
   }
 }
@@ -75,8 +75,7 @@ void WorldImpl::SplitLinkPairs(const std::vector<ShapePairContact*>& pairs) {
 // Per movable joint: its limits when the free step would reach them, its
 // speed limit when the free step would exceed it, its friction, and its
 // command's servo or motor. Efforts commanded directly are in Q already.
-void WorldImpl::AddArticulationRows(std::uint32_t index, int slot,
-                                    const ArticulationKinematics& k, const Eigen::VectorXd& u_free,
+void WorldImpl::AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free,
                                     double dt) {
   const ArticulationEntry& entry = articulations_[index];
   const ArticulationModel& model = entry.model;
@@ -124,7 +123,6 @@ void WorldImpl::AddArticulationRows(std::uint32_t index, int slot,
   }
 }
 
-
 void WorldImpl::SolveArticulations(double dt) {
   if (articulations_.empty()) return;
   articulation_solver_.Reset();
@@ -151,14 +149,14 @@ void WorldImpl::SolveArticulations(double dt) {
     ComputeDynamics(model, entry.state, k, settings_.gravity, efforts, &dynamics);
     Eigen::MatrixXd mass = dynamics.mass;
     for (const ArticulationJoint& joint : model.joints) {
-      if (joint.dof >= 0) mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += dt * joint.def.damping;
+      if (joint.dof >= 0)
+        mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += dt * joint.def.damping;
     }
     // Damping explicit in Q, implicit in the mass: (M + dt B) u* = M u + dt Q.
-    const Eigen::VectorXd u_free =
-        entry.state.u + mass.llt().solve(dt * dynamics.force);
+    const Eigen::VectorXd u_free = entry.state.u + mass.llt().solve(dt * dynamics.force);
     const std::size_t rows_before = articulation_solver_.rows().size();
     const int candidate = articulation_solver_.AddArticulation(u_free, mass);
-    AddArticulationRows(i, candidate, k, u_free, dt);
+    AddArticulationRows(i, candidate, u_free, dt);
     const bool has_rows = articulation_solver_.rows().size() > rows_before;
     const bool stiff_damping = (mass - dynamics.mass).norm() > 0.1 * dynamics.mass.norm();
     for (ArticulationJoint& joint : model.joints) {
@@ -176,7 +174,8 @@ void WorldImpl::SolveArticulations(double dt) {
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     if (slot[i] < 0) continue;
     ArticulationEntry& entry = articulations_[i];
-    entry.next = Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
+    entry.next =
+        Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
   }
   // A joint's effort: its command's, its rows' impulses over dt, less its
   // damping.
@@ -195,15 +194,24 @@ void WorldImpl::SolveArticulations(double dt) {
   }
   for (const ArticulationSolver::BodySlot& slot_body : articulation_solver_.bodies()) {
     Body& body = bodies_[slot_body.body];
-    if (body.inverse_mass == 0.0 || !body.awake || body.disabled || body.articulation >= 0) continue;
+    if (body.inverse_mass == 0.0 || !body.awake || body.disabled || body.articulation >= 0)
+      continue;
     const Vec3 linear_change = slot_body.linear_velocity - body.linear_velocity;
     const Mat3 rotation = body.orientation.toRotationMatrix();
-    const Vec3 angular_momentum = rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+    const Vec3 angular_momentum = rotation *
+                                  body.inverse_principal_moments.cwiseInverse().asDiagonal() *
                                   (rotation.transpose() * slot_body.angular_velocity);
-    // The impulses act at the start of the step, as on the links they
-    // push against: the whole change drifts.
-    body.start_linear_velocity += linear_change;
-    body.start_angular_momentum += angular_momentum - body.angular_momentum;
+    // A change that resting forces can make within the step (at most the
+    // collision threshold beyond what gravity gives) is a force over it:
+    // the trapezoidal drift keeps it exact, as kinetic friction on a
+    // lifted box. A larger one stops an impact, an impulse at the start of
+    // the step whose whole change drifts.
+    const double resting = settings_.solver.collision_velocity_threshold +
+                           settings_.time_step * settings_.gravity.norm();
+    if (linear_change.norm() > resting) {
+      body.start_linear_velocity += linear_change;
+      body.start_angular_momentum += angular_momentum - body.angular_momentum;
+    }
     body.linear_momentum = body.mass * slot_body.linear_velocity;
     body.angular_momentum = angular_momentum;
     body.UpdateDerived();
@@ -236,8 +244,8 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
         const int articulation_slot = slot_of_articulation[body.articulation];
         const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
         const Vec3 r = point - body.position;
-        const Eigen::VectorXd row =
-            jacobian.topRows<3>().transpose() * direction + jacobian.bottomRows<3>().transpose() * r.cross(direction);
+        const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
+                                    jacobian.bottomRows<3>().transpose() * r.cross(direction);
         return articulation_solver_.ArticulationSide(articulation_slot, row);
       }
       ArticulationSolver::BodySlot body_slot;
@@ -260,7 +268,8 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
       normal_row.b = side(pair.body_b, -normal, point.position_world);
       const double approach = articulation_solver_.RowVelocity(normal_row);
       const double separation = point.separation;
-      if (separation <= solver.contact_tolerance && approach < -solver.collision_velocity_threshold) {
+      if (separation <= solver.contact_tolerance &&
+          approach < -solver.collision_velocity_threshold) {
         normal_row.target = -restitution * approach;
         normal_row.colliding = true;
       } else if (separation > 0.0) {
@@ -299,10 +308,11 @@ void WorldImpl::ReportLinkContacts(double dt) {
     for (int i = 0; i < pair.manifold.point_count; ++i) {
       const ConstraintRow& normal = rows[first + 3 * i];
       const ContactPoint& point = pair.manifold.points[i];
-      pair.previous[i] = CachedImpulse{point.feature,
-                                       normal.impulse,
-                                       {rows[first + 3 * i + 1].impulse, rows[first + 3 * i + 2].impulse},
-                                       point.position_world};
+      pair.previous[i] =
+          CachedImpulse{point.feature,
+                        normal.impulse,
+                        {rows[first + 3 * i + 1].impulse, rows[first + 3 * i + 2].impulse},
+                        point.position_world};
       const bool touching = point.separation <= settings_.solver.contact_tolerance;
       if (!touching && normal.impulse <= 0.0) continue;
       ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, tangent, dt));

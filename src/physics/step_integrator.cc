@@ -184,7 +184,8 @@ std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePai
     if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) continue;
     // A link's contacts are the articulation solve's, which lets no point
     // close more than its gap within a step.
-    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0) continue;
+    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0)
+      continue;
     double approach_speed = 0.0;
     const double time = PairImpactTime(dt, pair, &approach_speed);
     if (!std::isfinite(time)) continue;

@@ -18,10 +18,10 @@ Status ValidateJoint(const ArticulationDef& def, std::size_t k) {
   const JointDef& joint = def.joints[k];
   if (joint.child_link != static_cast<int>(k) + 1 || joint.parent_link < 0 ||
       joint.parent_link > static_cast<int>(k)) {
-    return Status::Error(JointField(k, joint.name, "must join link " + std::to_string(k + 1) +
-                                                       " to an earlier link; joins " +
-                                                       std::to_string(joint.parent_link) + " to " +
-                                                       std::to_string(joint.child_link)));
+    return Status::Error(JointField(
+        k, joint.name,
+        "must join link " + std::to_string(k + 1) + " to an earlier link; joins " +
+            std::to_string(joint.parent_link) + " to " + std::to_string(joint.child_link)));
   }
   if (!IsFinite(joint.axis) || !(joint.axis.norm() > 1e-9)) {
     return Status::Error(JointField(k, joint.name, "axis must be finite and non-zero"));
@@ -32,10 +32,11 @@ Status ValidateJoint(const ArticulationDef& def, std::size_t k) {
     return Status::Error(JointField(k, joint.name, "origin must be finite with a unit quaternion"));
   }
   const bool limited = joint.type != JointType::kContinuous;
-  if (limited && (std::isnan(joint.lower) || std::isnan(joint.upper) || joint.lower > joint.upper)) {
-    return Status::Error(JointField(k, joint.name, "limits [" + FormatNumber(joint.lower) + ", " +
-                                                       FormatNumber(joint.upper) +
-                                                       "] must have lower <= upper"));
+  if (limited &&
+      (std::isnan(joint.lower) || std::isnan(joint.upper) || joint.lower > joint.upper)) {
+    return Status::Error(JointField(k, joint.name,
+                                    "limits [" + FormatNumber(joint.lower) + ", " +
+                                        FormatNumber(joint.upper) + "] must have lower <= upper"));
   }
   if (!(joint.effort_limit > 0.0) || !(joint.velocity_limit > 0.0)) {
     return Status::Error(JointField(k, joint.name,
@@ -45,14 +46,14 @@ Status ValidateJoint(const ArticulationDef& def, std::size_t k) {
   }
   if (!(joint.damping >= 0.0) || !std::isfinite(joint.damping) || !(joint.friction >= 0.0) ||
       !std::isfinite(joint.friction)) {
-    return Status::Error(JointField(k, joint.name, "damping " + FormatNumber(joint.damping) +
-                                                       " and friction " +
-                                                       FormatNumber(joint.friction) +
-                                                       " must be finite and >= 0"));
+    return Status::Error(JointField(k, joint.name,
+                                    "damping " + FormatNumber(joint.damping) + " and friction " +
+                                        FormatNumber(joint.friction) + " must be finite and >= 0"));
   }
   if (joint.mimic_joint >= 0) {
-    if (joint.mimic_joint >= static_cast<int>(k) || def.joints[joint.mimic_joint].mimic_joint >= 0 ||
-        !std::isfinite(joint.mimic_multiplier) || !std::isfinite(joint.mimic_offset)) {
+    if (joint.mimic_joint >= static_cast<int>(k) ||
+        def.joints[joint.mimic_joint].mimic_joint >= 0 || !std::isfinite(joint.mimic_multiplier) ||
+        !std::isfinite(joint.mimic_offset)) {
       return Status::Error(JointField(
           k, joint.name, "must mimic an earlier joint that mimics none, with finite factors"));
     }
@@ -62,10 +63,10 @@ Status ValidateJoint(const ArticulationDef& def, std::size_t k) {
     return Status::Error(JointField(k, joint.name, "position and velocity must be finite"));
   }
   if (limited && (joint.position < joint.lower || joint.position > joint.upper)) {
-    return Status::Error(JointField(k, joint.name, "position " + FormatNumber(joint.position) +
-                                                       " is outside its limits [" +
-                                                       FormatNumber(joint.lower) + ", " +
-                                                       FormatNumber(joint.upper) + "]"));
+    return Status::Error(JointField(k, joint.name,
+                                    "position " + FormatNumber(joint.position) +
+                                        " is outside its limits [" + FormatNumber(joint.lower) +
+                                        ", " + FormatNumber(joint.upper) + "]"));
   }
   return Status::Ok();
 }
@@ -121,8 +122,8 @@ ArticulationModel MakeModel(const ArticulationDef& def) {
 
 Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def) {
   if (Status status = ValidateArticulation(def); !status.ok()) return status;
-  if (Status status = ValidateState(def.world_from_base, def.base_linear_velocity,
-                                    def.base_angular_velocity);
+  if (Status status =
+          ValidateState(def.world_from_base, def.base_linear_velocity, def.base_angular_velocity);
       !status.ok()) {
     return Status::Error("base: " + status.message());
   }
@@ -140,8 +141,9 @@ Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def)
     state.u[entry.model.base_dofs + joint.dof] = joint.def.velocity;
   }
   if (!def.fixed_base) {
-    state.u.head<3>() = def.base_linear_velocity +
-                        def.base_angular_velocity.cross(state.base_com - def.world_from_base.translation);
+    state.u.head<3>() =
+        def.base_linear_velocity +
+        def.base_angular_velocity.cross(state.base_com - def.world_from_base.translation);
     state.u.segment<3>(3) = def.base_angular_velocity;
   }
   entry.next = state;
@@ -156,13 +158,15 @@ Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def)
     body_def.world_from_body = k.world_from_link[i];
     body_def.angular_velocity = k.angular_velocity[i];
     body_def.linear_velocity =
-        k.linear_velocity[i] + k.angular_velocity[i].cross(k.world_from_link[i].translation - k.com_world[i]);
+        k.linear_velocity[i] +
+        k.angular_velocity[i].cross(k.world_from_link[i].translation - k.com_world[i]);
     body_def.mass_properties = def.links[i].mass_properties;
     body_def.shapes = def.links[i].shapes;
     body_def.user_data = def.user_data;
     Result<BodyId> body = CreateBody(body_def);
     if (!body.ok()) {
-      for (std::size_t made = 0; made < i; ++made) DestroyBody(BodyIdOf(entry.model.links[made].body));
+      for (std::size_t made = 0; made < i; ++made)
+        DestroyBody(BodyIdOf(entry.model.links[made].body));
       return Status::Error("link " + std::to_string(i) + " ('" + def.links[i].name +
                            "'): " + body.status().message());
     }
@@ -228,23 +232,24 @@ Status WorldImpl::SetJointStates(ArticulationId id, const std::vector<double>& p
   ArticulationEntry& entry = articulations_[id.index];
   const std::size_t count = entry.model.joints.size();
   if (positions.size() != count || velocities.size() != count) {
-    return Status::Error("joint state needs " + std::to_string(count) + " positions and velocities, got " +
-                         std::to_string(positions.size()) + " and " + std::to_string(velocities.size()));
+    return Status::Error("joint state needs " + std::to_string(count) +
+                         " positions and velocities, got " + std::to_string(positions.size()) +
+                         " and " + std::to_string(velocities.size()));
   }
   ArticulationState state = entry.state;
   for (std::size_t j = 0; j < count; ++j) {
     const ArticulationJoint& joint = entry.model.joints[j];
     if (!std::isfinite(positions[j]) || !std::isfinite(velocities[j])) {
-      return Status::Error(JointField(j, joint.def.name, "position " + FormatNumber(positions[j]) +
-                                                             " and velocity " + FormatNumber(velocities[j]) +
-                                                             " must be finite"));
+      return Status::Error(JointField(j, joint.def.name,
+                                      "position " + FormatNumber(positions[j]) + " and velocity " +
+                                          FormatNumber(velocities[j]) + " must be finite"));
     }
     if (joint.dof < 0) continue;
     if (positions[j] < joint.def.lower || positions[j] > joint.def.upper) {
-      return Status::Error(JointField(j, joint.def.name, "position " + FormatNumber(positions[j]) +
-                                                             " is outside its limits [" +
-                                                             FormatNumber(joint.def.lower) + ", " +
-                                                             FormatNumber(joint.def.upper) + "]"));
+      return Status::Error(JointField(
+          j, joint.def.name,
+          "position " + FormatNumber(positions[j]) + " is outside its limits [" +
+              FormatNumber(joint.def.lower) + ", " + FormatNumber(joint.def.upper) + "]"));
     }
     state.q[joint.dof] = positions[j];
     state.u[entry.model.base_dofs + joint.dof] = velocities[j];
@@ -268,7 +273,8 @@ Status WorldImpl::SetJointCommand(ArticulationId id, int joint, const JointComma
   }
   ArticulationJoint& target = entry.model.joints[joint];
   if (target.dof < 0 && command.mode != JointCommandMode::kNone) {
-    return Status::Error(JointField(joint, target.def.name, "mimics another joint; command its leader"));
+    return Status::Error(
+        JointField(joint, target.def.name, "mimics another joint; command its leader"));
   }
   target.command = command;
   return Status::Ok();
@@ -278,8 +284,9 @@ Status WorldImpl::SetServoGains(ArticulationId id, const ServoGains& gains) {
   if (!IsValid(id)) return Status::Error("no articulation with this id");
   if (!(gains.stiffness > 0.0) || !std::isfinite(gains.stiffness) || !(gains.damping >= 0.0) ||
       !std::isfinite(gains.damping)) {
-    return Status::Error("servo stiffness " + FormatNumber(gains.stiffness) + " must be finite and > 0, damping " +
-                         FormatNumber(gains.damping) + " finite and >= 0");
+    return Status::Error("servo stiffness " + FormatNumber(gains.stiffness) +
+                         " must be finite and > 0, damping " + FormatNumber(gains.damping) +
+                         " finite and >= 0");
   }
   articulations_[id.index].gains = gains;
   return Status::Ok();
@@ -295,13 +302,15 @@ Status WorldImpl::MoveArticulation(std::uint32_t index, const Pose& world_from_l
   ArticulationEntry& entry = articulations_[index];
   ArticulationKinematics k;
   ComputeKinematics(entry.model, entry.state, &k);
-  const Pose world_from_base = world_from_link * k.world_from_link[link].Inverse() * k.world_from_link[0];
+  const Pose world_from_base =
+      world_from_link * k.world_from_link[link].Inverse() * k.world_from_link[0];
   ArticulationState state = entry.state;
   state.base_rotation = world_from_base.rotation.normalized();
   state.base_com = world_from_base * entry.model.links[0].com_link;
   state.u.setZero();
   if (!entry.model.fixed_base) {
-    state.u.head<3>() = linear_velocity + angular_velocity.cross(state.base_com - world_from_link.translation);
+    state.u.head<3>() =
+        linear_velocity + angular_velocity.cross(state.base_com - world_from_link.translation);
     state.u.segment<3>(3) = angular_velocity;
   }
   entry.state = state;
@@ -322,7 +331,8 @@ void WorldImpl::PlaceLinks(std::uint32_t index, const ArticulationState& state, 
     const Vec3 start_com = body.position;
     const Quat start_rotation = body.orientation;
     const Vec3 origin_velocity =
-        k.linear_velocity[i] + k.angular_velocity[i].cross(k.world_from_link[i].translation - k.com_world[i]);
+        k.linear_velocity[i] +
+        k.angular_velocity[i].cross(k.world_from_link[i].translation - k.com_world[i]);
     SetBodyState(k.world_from_link[i], origin_velocity, k.angular_velocity[i], &body);
     body.disabled = false;
     // The narrow phase skips pairs by how far their bodies travelled.

@@ -25,8 +25,6 @@ std::string Describe(const Vec3& v) {
   return out.str();
 }
 
-
-
 }  // namespace
 
 Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,

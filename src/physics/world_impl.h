@@ -155,8 +155,7 @@ class WorldImpl {
   // solver's) and those with a link (the articulation solve's).
   void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
   void SolveArticulations(double dt);
-  void AddArticulationRows(std::uint32_t index, int slot, const ArticulationKinematics& k,
-                           const Eigen::VectorXd& u_free, double dt);
+  void AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free, double dt);
   void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
                           const std::vector<ArticulationKinematics>& kinematics);
   void ReportLinkContacts(double dt);

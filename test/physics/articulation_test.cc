@@ -5,6 +5,9 @@
 // and a link resting on the ground.
 #include <cmath>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -90,8 +93,8 @@ TEST(ArticulationTest, PendulumPeriodMatchesTheEllipticIntegral) {
     def.joints = {Hinge(1, 0.0, amplitude)};
     const ArticulationId pendulum = world.CreateArticulation(def).value();
     const double inertia = mass * 1e-4 + mass * length * length;
-    const double expected = 4.0 * std::sqrt(inertia / (mass * kG * length)) *
-                            EllipticK(std::sin(0.5 * amplitude));
+    const double expected =
+        4.0 * std::sqrt(inertia / (mass * kG * length)) * EllipticK(std::sin(0.5 * amplitude));
     std::vector<double> crossings;
     double previous = amplitude;
     for (int step = 1; crossings.size() < 11 && step < 100000; ++step) {
@@ -301,6 +304,118 @@ TEST(ArticulationTest, FloatingArticulationRestsOnTheGround) {
   const Pose base = world.GetPose(world.ArticulationLinks(id)[0]);
   EXPECT_NEAR(base.translation.z(), 0.1, 1e-3);
   EXPECT_LT(world.GetLinearVelocity(world.ArticulationLinks(id)[0]).norm(), 1e-2);
+}
+
+// A damped pendulum at small amplitude: theta'' + (b / I) theta' +
+// (m g l / I) theta = 0, whose peaks decay as exp(-b t / (2 I)). The rate
+// is measured from the first and the tenth peak, each placed by a parabola
+// through the three samples around it.
+TEST(ArticulationTest, DampedPendulumDecaysAtTheClosedFormRate) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(1.0, 1.0)};
+  JointDef hinge = Hinge(1, 0.0, 0.02);
+  hinge.damping = 0.1;  // N m s/rad
+  def.joints = {hinge};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  const double inertia = 1e-4 + 1.0;
+  std::vector<std::pair<double, double>> peaks;  // (time, value)
+  double a = 0.02;
+  double b = 0.02;
+  for (int step = 1; peaks.size() < 10 && step < 100000; ++step) {
+    world.Step();
+    const double c = world.GetJointStates(id)[0].position;
+    if (step >= 2 && b > a && b >= c) {
+      // Vertex of the parabola through (-1, a), (0, b), (1, c).
+      const double offset = 0.5 * (a - c) / (a - 2.0 * b + c);
+      const double value = b - 0.25 * (a - c) * offset;
+      peaks.emplace_back((step - 1 + offset) * kDt, value);
+    }
+    a = b;
+    b = c;
+  }
+  ASSERT_EQ(peaks.size(), 10u);
+  const double rate = std::log(peaks.front().second / peaks.back().second) /
+                      (peaks.back().first - peaks.front().first);
+  EXPECT_NEAR(rate / (hinge.damping / (2.0 * inertia)), 1.0, 1e-2);
+}
+
+LinkDef BoxLink(double mass, const Vec3& size, double friction) {
+  LinkDef link;
+  link.mass_properties = BoxMassProperties(mass / size.prod(), size);
+  ShapeDef shape;
+  shape.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(size));
+  shape.material = MakeMaterial(friction, 0.0);
+  link.shapes.push_back(shape);
+  return link;
+}
+
+JointDef Slider(const std::string& name, int parent, int child, const Vec3& origin,
+                const Vec3& axis) {
+  JointDef joint;
+  joint.name = name;
+  joint.type = JointType::kPrismatic;
+  joint.parent_link = parent;
+  joint.child_link = child;
+  joint.parent_from_joint.translation = origin;
+  joint.axis = axis;
+  joint.lower = -0.5;
+  joint.upper = 0.5;
+  joint.effort_limit = 1000.0;
+  return joint;
+}
+
+// A parallel gripper on a lift: two fingers squeeze a 0.2 kg box with 20 N
+// each (mu = 1), the lift raises it 0.2 m in 1 s and holds it 5 s. The box
+// rises with the hand and slips less than 5 mm relative to it.
+TEST(ArticulationTest, GripperLiftsABoxWithoutLettingItSlip) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(1.0, 0.0));
+  BoxSpec spec;
+  spec.size = Vec3(0.05, 0.05, 0.05);
+  spec.mass = 0.2;
+  spec.world_from_body = Translation(0, 0, 0.025);
+  spec.material = MakeMaterial(1.0, 0.0);
+  const BodyId box = AddBox(&world, spec);
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.world_from_base = Translation(0, 0, 0.1);
+  def.links = {Anchor(), BoxLink(1.0, Vec3(0.1, 0.2, 0.02), 1.0),
+               BoxLink(0.1, Vec3(0.04, 0.01, 0.06), 1.0),
+               BoxLink(0.1, Vec3(0.04, 0.01, 0.06), 1.0)};
+  // The lift slides along z; each finger hangs 0.06 m below the carriage and
+  // closes toward y = 0 along its axis.
+  def.joints = {Slider("lift", 0, 1, Vec3::Zero(), Vec3::UnitZ()),
+                Slider("left", 1, 2, Vec3(0, 0.032, -0.06), -Vec3::UnitY()),
+                Slider("right", 1, 3, Vec3(0, -0.032, -0.06), Vec3::UnitY())};
+  const ArticulationId hand = world.CreateArticulation(def).value();
+  JointCommand hold_lift;
+  hold_lift.mode = JointCommandMode::kPosition;
+  ASSERT_TRUE(world.SetJointCommand(hand, 0, hold_lift).ok());
+  JointCommand squeeze;
+  squeeze.mode = JointCommandMode::kEffort;
+  squeeze.effort = 20.0;
+  ASSERT_TRUE(world.SetJointCommand(hand, 1, squeeze).ok());
+  ASSERT_TRUE(world.SetJointCommand(hand, 2, squeeze).ok());
+  for (int step = 0; step < 120; ++step) world.Step();
+  const int lift_steps = 240;
+  for (int step = 1; step <= lift_steps; ++step) {
+    hold_lift.position = 0.2 * step / lift_steps;
+    hold_lift.velocity = 0.2;
+    ASSERT_TRUE(world.SetJointCommand(hand, 0, hold_lift).ok());
+    world.Step();
+  }
+  hold_lift.velocity = 0.0;
+  ASSERT_TRUE(world.SetJointCommand(hand, 0, hold_lift).ok());
+  const BodyId carriage = world.ArticulationLinks(hand)[1];
+  const double start_offset =
+      world.GetPose(box).translation.z() - world.GetPose(carriage).translation.z();
+  for (int step = 0; step < 5 * 240; ++step) world.Step();
+  const double end_offset =
+      world.GetPose(box).translation.z() - world.GetPose(carriage).translation.z();
+  EXPECT_NEAR(world.GetPose(box).translation.z(), 0.025 + 0.2, 5e-3);
+  EXPECT_LT(std::abs(end_offset - start_offset), 5e-3);
 }
 
 }  // namespace

@@ -26,10 +26,10 @@ enum class JointType : std::uint8_t {
 struct JointDef {
   std::string name;
   JointType type = JointType::kRevolute;
-  int parent_link = 0;       // index into ArticulationDef::links, < child_link
-  int child_link = 1;        // each link but the base is the child of one joint
-  Pose parent_from_joint;    // the joint frame in the parent link frame (<origin>)
-  Vec3 axis = Vec3::UnitX(); // unit, joint frame
+  int parent_link = 0;        // index into ArticulationDef::links, < child_link
+  int child_link = 1;         // each link but the base is the child of one joint
+  Pose parent_from_joint;     // the joint frame in the parent link frame (<origin>)
+  Vec3 axis = Vec3::UnitX();  // unit, joint frame
   double lower = -std::numeric_limits<double>::infinity();  // rad or m; revolute, prismatic
   double upper = std::numeric_limits<double>::infinity();
   double effort_limit = std::numeric_limits<double>::infinity();    // N m or N, > 0
