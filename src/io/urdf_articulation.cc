@@ -67,20 +67,15 @@ Result<ArticulationDef> MakeArticulationDef(const LoadedModel& model,
     def_joint.damping = joint.damping;
     def_joint.friction = joint.friction;
     def_joint.position = joint.position;
-    if (!joint.mimic_joint.empty()) {
-      def_joint.mimic_joint = joint_index.at(joint.mimic_joint);
-      def_joint.mimic_multiplier = joint.mimic_multiplier;
-      def_joint.mimic_offset = joint.mimic_offset;
-    }
+    def_joint.mimic_multiplier = joint.mimic_multiplier;
+    def_joint.mimic_offset = joint.mimic_offset;
     joint_index[joint.name] = static_cast<int>(def.joints.size()) - 1;
   }
-  // A mimic joint may come before its leader in tree order; the core takes
-  // leaders first, so such a model is refused by name.
+  // Leaders may come after their mimics in tree order: linked once all are
+  // numbered (the loader checked that each leader is a movable joint).
   for (const JointInfo& joint : model.joints) {
-    if (!joint.mimic_joint.empty() && joint_index.count(joint.mimic_joint) == 0) {
-      return Result<ArticulationDef>::Error("joint '" + joint.name + "' mimics '" +
-                                            joint.mimic_joint + "', which comes after it");
-    }
+    if (joint.mimic_joint.empty()) continue;
+    def.joints[joint_index.at(joint.name)].mimic_joint = joint_index.at(joint.mimic_joint);
   }
 
   std::vector<std::vector<MassProperties>> parts(group_root.size());

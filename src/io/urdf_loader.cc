@@ -203,11 +203,20 @@ class ModelBuilder {
     loaded.name = model.getName();
     urdf::LinkConstSharedPtr body_root = model.getRoot();
     if (body_root->name == kWorldLink) {
-      loaded.is_static = true;
       if (body_root->child_links.size() != 1) {
         return Result<LoadedModel>::Error("link 'world' must have exactly one child link, has " +
                                           std::to_string(body_root->child_links.size()));
       }
+      // A fixed joint to the world makes the model static; a floating one
+      // leaves its root free.
+      const int world_type = body_root->child_links.front()->parent_joint->type;
+      if (world_type != urdf::Joint::FIXED && world_type != urdf::Joint::FLOATING) {
+        return Result<LoadedModel>::Error("joint '" +
+                                          body_root->child_links.front()->parent_joint->name +
+                                          "' to link 'world' is " + JointTypeName(world_type) +
+                                          "; a joint to 'world' must be fixed or floating");
+      }
+      loaded.is_static = world_type == urdf::Joint::FIXED;
       if (!body_root->collision_array.empty() || body_root->inertial != nullptr) {
         loaded.warnings.push_back(
             "link 'world' stands for the fixed world; its <collision> and <inertial> are ignored");
@@ -241,6 +250,7 @@ class ModelBuilder {
   Status CheckJoints(const urdf::ModelInterface& model) const {
     for (const auto& [name, joint] : model.joints_) {
       if (joint->type == urdf::Joint::FIXED) continue;
+      if (joint->type == urdf::Joint::FLOATING && joint->parent_link_name == kWorldLink) continue;
       if (!IsWeldable(joint->type)) {
         return Status::Error("joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
                              "; supported joints are fixed, revolute, continuous and prismatic" +

@@ -273,9 +273,8 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     const Status added = registry_.Add(std::move(model));
     assert(added.ok());
     const Model& stored = *registry_.Find(spec.name);
-    if (stored.is_static) {
-      outbox.tf_static = StaticTfLocked();
-    } else {
+    if (stored.is_static || stored.articulation.IsValid()) outbox.tf_static = StaticTfLocked();
+    if (!stored.is_static) {
       outbox.tf = ModelTfLocked(stored);
       outbox.tf_is_new_frame = true;
       outbox.reset_count = reset_count_;

@@ -78,7 +78,7 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
       return Fail(response, "no model named '" + request.name + "'", names::kDeleteService);
     }
     const std::vector<BodyId> bodies = model->bodies;
-    const bool was_static = model->is_static;
+    const bool was_static = model->is_static || model->articulation.IsValid();
     const Status destroyed = model->articulation.IsValid()
                                  ? world_.DestroyArticulation(model->articulation)
                                  : world_.DestroyBody(model->body);

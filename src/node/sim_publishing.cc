@@ -1,5 +1,6 @@
 // What the node publishes: tf, model states, contacts and their markers, and
 // /clock, built under the world lock and sent after it is released.
+#include <cassert>
 #include <string>
 #include <vector>
 
@@ -24,36 +25,76 @@ ros::Time SimNode::StampLocked() const {
   return options_.use_sim_time ? SimTimeToRos(world_.time()) : ros::Time::now();
 }
 
+namespace {
+
+std::size_t LinkIndex(const Model& model, const std::string& link_name) {
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    if (model.links[i].link_name == link_name) return i;
+  }
+  assert(false && "a joint names a link of its model");
+  return 0;
+}
+
+}  // namespace
+
+// A rigid model: every link frame from the world frame. An articulated one
+// follows the URDF tree: the world to its root link, then each movable
+// joint's parent link to its child link (its fixed joints are static).
+void SimNode::AppendModelTfLocked(const Model& model, const ros::Time& stamp,
+                                  tf2_msgs::TFMessage* tf) const {
+  if (!model.articulation.IsValid()) {
+    for (std::size_t i = 0; i < model.links.size(); ++i) {
+      tf->transforms.push_back(
+          TransformToMsg(LinkStateLocked(model, i).world_from_frame, options_.world_frame,
+                         FrameName(model.name, model.links[i].link_name), stamp));
+    }
+    return;
+  }
+  tf->transforms.push_back(TransformToMsg(LinkStateLocked(model, 0).world_from_frame,
+                                          options_.world_frame,
+                                          FrameName(model.name, model.links[0].link_name), stamp));
+  for (const io::JointInfo& joint : model.joints) {
+    if (joint.type == "fixed") continue;
+    const physics::Pose world_from_parent =
+        LinkStateLocked(model, LinkIndex(model, joint.parent_link)).world_from_frame;
+    const physics::Pose world_from_child =
+        LinkStateLocked(model, LinkIndex(model, joint.child_link)).world_from_frame;
+    tf->transforms.push_back(TransformToMsg(world_from_parent.Inverse() * world_from_child,
+                                            FrameName(model.name, joint.parent_link),
+                                            FrameName(model.name, joint.child_link), stamp));
+  }
+}
+
 tf2_msgs::TFMessage SimNode::ModelTfLocked(const Model& model) const {
   tf2_msgs::TFMessage tf;
-  const ros::Time stamp = StampLocked();
-  for (std::size_t i = 0; i < model.links.size(); ++i) {
-    tf.transforms.push_back(TransformToMsg(LinkStateLocked(model, i).world_from_frame,
-                                           options_.world_frame,
-                                           FrameName(model.name, model.links[i].link_name), stamp));
-  }
+  AppendModelTfLocked(model, StampLocked(), &tf);
   return tf;
 }
 
+// The frames of static models, and the fixed joints of articulated ones.
 tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
   tf2_msgs::TFMessage tf;
+  const ros::Time stamp = StampLocked();
   for (const auto& [name, model] : registry_.models()) {
-    if (!model.is_static) continue;
-    tf2_msgs::TFMessage model_tf = ModelTfLocked(model);
-    tf.transforms.insert(tf.transforms.end(), model_tf.transforms.begin(),
-                         model_tf.transforms.end());
+    if (model.is_static) AppendModelTfLocked(model, stamp, &tf);
+    if (!model.articulation.IsValid()) continue;
+    for (const io::JointInfo& joint : model.joints) {
+      if (joint.type != "fixed") continue;
+      const physics::Pose& root_from_parent =
+          model.links[LinkIndex(model, joint.parent_link)].root_from_link;
+      const physics::Pose& root_from_child =
+          model.links[LinkIndex(model, joint.child_link)].root_from_link;
+      tf.transforms.push_back(TransformToMsg(root_from_parent.Inverse() * root_from_child,
+                                             FrameName(name, joint.parent_link),
+                                             FrameName(name, joint.child_link), stamp));
+    }
   }
   return tf;
 }
 
 void SimNode::FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const {
   for (const auto& [name, model] : registry_.models()) {
-    if (model.is_static) continue;
-    for (std::size_t i = 0; i < model.links.size(); ++i) {
-      tf->transforms.push_back(TransformToMsg(LinkStateLocked(model, i).world_from_frame,
-                                              options_.world_frame,
-                                              FrameName(name, model.links[i].link_name), stamp));
-    }
+    if (!model.is_static) AppendModelTfLocked(model, stamp, tf);
   }
 }
 

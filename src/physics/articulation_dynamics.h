@@ -33,6 +33,9 @@ struct ArticulationJoint {
   int dof = -1;  // index into the joint velocities; -1 for a mimic joint
   JointCommand command;
   double effort = 0.0;  // N m or N transmitted in the last step
+  // 1 + the sum of its mimics' squared multipliers: the generalized force on
+  // its dof when it and each mimic exert the same effort (scaled).
+  double effort_scale = 1.0;
 };
 
 // The state integrated over time: the base (its centre of mass and

@@ -38,12 +38,15 @@ Eigen::VectorXd Unit(int size, int index, double sign) {
   return e;
 }
 
-// The efforts commanded directly, clamped to each joint's limit, per dof.
+// The generalized efforts commanded directly, per dof: each joint's
+// command clamped to its limit, which its mimics exert too (scaled by their
+// multipliers), so a dof with mimics gets effort_scale times it.
 Eigen::VectorXd CommandedEfforts(const ArticulationModel& model) {
   Eigen::VectorXd efforts = Eigen::VectorXd::Zero(model.joint_dofs);
   for (const ArticulationJoint& joint : model.joints) {
     if (joint.dof < 0 || joint.command.mode != JointCommandMode::kEffort) continue;
     efforts[joint.dof] =
+        joint.effort_scale *
         std::clamp(joint.command.effort, -joint.def.effort_limit, joint.def.effort_limit);
   }
   return efforts;
@@ -106,7 +109,8 @@ void WorldImpl::AddArticulationRows(std::uint32_t index, int slot, const Eigen::
       add(u > 0.0 ? -1.0 : 1.0, RowKind::kNormal, -def.velocity_limit, 0.0, 0.0);
     }
     if (def.friction > 0.0) add(1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
-    const double effort_bound = def.effort_limit * dt;
+    // Each of the joints the dof moves may exert its own limit.
+    const double effort_bound = joint.effort_scale * def.effort_limit * dt;
     if (joint.command.mode == JointCommandMode::kVelocity) {
       add(1.0, RowKind::kBounded, joint.command.velocity, effort_bound, 0.0);
     } else if (joint.command.mode == JointCommandMode::kPosition) {
@@ -178,7 +182,7 @@ void WorldImpl::SolveArticulations(double dt) {
         Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
   }
   // A joint's effort: its command's, its rows' impulses over dt, less its
-  // damping.
+  // damping; shared with its mimics, each taking its multiplier's part.
   for (const ConstraintRow& row : articulation_solver_.rows()) {
     if (row.joint < 0) continue;
     ArticulationEntry& entry = articulations_[row.articulation];
@@ -187,9 +191,13 @@ void WorldImpl::SolveArticulations(double dt) {
   for (ArticulationEntry& entry : articulations_) {
     if (!entry.in_use) continue;
     for (ArticulationJoint& joint : entry.model.joints) {
-      if (joint.dof >= 0) {
-        joint.effort -= joint.def.damping * entry.next.u[entry.model.base_dofs + joint.dof];
-      }
+      if (joint.dof < 0) continue;
+      joint.effort -= joint.def.damping * entry.next.u[entry.model.base_dofs + joint.dof];
+      joint.effort /= joint.effort_scale;
+    }
+    for (ArticulationJoint& joint : entry.model.joints) {
+      if (joint.dof >= 0) continue;
+      joint.effort = joint.def.mimic_multiplier * entry.model.joints[joint.def.mimic_joint].effort;
     }
   }
   for (const ArticulationSolver::BodySlot& slot_body : articulation_solver_.bodies()) {

@@ -51,11 +51,12 @@ Status ValidateJoint(const ArticulationDef& def, std::size_t k) {
                                         FormatNumber(joint.friction) + " must be finite and >= 0"));
   }
   if (joint.mimic_joint >= 0) {
-    if (joint.mimic_joint >= static_cast<int>(k) ||
+    if (joint.mimic_joint >= static_cast<int>(def.joints.size()) ||
+        joint.mimic_joint == static_cast<int>(k) ||
         def.joints[joint.mimic_joint].mimic_joint >= 0 || !std::isfinite(joint.mimic_multiplier) ||
         !std::isfinite(joint.mimic_offset)) {
       return Status::Error(JointField(
-          k, joint.name, "must mimic an earlier joint that mimics none, with finite factors"));
+          k, joint.name, "must mimic another joint that mimics none, with finite factors"));
     }
     return Status::Ok();
   }
@@ -114,6 +115,11 @@ ArticulationModel MakeModel(const ArticulationDef& def) {
     }
     if (joint_def.mimic_joint < 0) joint.dof = model.joint_dofs++;
     model.links[joint_def.child_link].parent_joint = static_cast<int>(model.joints.size()) - 1;
+  }
+  for (const ArticulationJoint& joint : model.joints) {
+    if (joint.dof >= 0) continue;
+    model.joints[joint.def.mimic_joint].effort_scale +=
+        joint.def.mimic_multiplier * joint.def.mimic_multiplier;
   }
   return model;
 }

@@ -563,5 +563,30 @@ TEST(UrdfLoaderTest, ArticulatedModelKeepsItsJoints) {
   EXPECT_NE(refused.message().find("joint 'slider' is planar"), std::string::npos);
 }
 
+// A floating joint to 'world' leaves the root free; a movable one is
+// refused by name.
+TEST(UrdfLoaderTest, JointToWorldIsFixedOrFloating) {
+  const auto urdf = [](const std::string& type) {
+    return "<robot name=\"r\"><link name=\"world\"/><joint name=\"to_world\" type=\"" + type +
+           "\"><parent link=\"world\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+           "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>"
+           "<link name=\"b\"><collision><geometry><sphere radius=\"0.1\"/></geometry>"
+           "</collision></link></robot>";
+  };
+  UrdfLoadOptions options;
+  options.articulate = true;
+  Result<LoadedModel> model = LoadUrdfString(urdf("fixed"), options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_TRUE(model->is_static);
+  model = LoadUrdfString(urdf("floating"), options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_FALSE(model->is_static);
+  model = LoadUrdfString(urdf("revolute"), options);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.message(),
+            "joint 'to_world' to link 'world' is revolute; a joint to 'world' must be fixed or "
+            "floating");
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::io

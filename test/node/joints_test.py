@@ -11,6 +11,7 @@ import threading
 import unittest
 
 import rospkg
+import yaml
 import rospy
 import tf2_ros
 from geometry_msgs.msg import Pose
@@ -197,8 +198,13 @@ class JointsTest(unittest.TestCase):
         self.assertIsNotNone(listener)
         transform = buffer.lookup_transform('world', 'arm4/tool', rospy.Time(0),
                                             rospy.Duration(10.0))
-        # Shoulder at pi/2 about y turns the arm from -z to -x; the tool is
-        # 1 m from the shoulder, which is 0.05 m below the base.
+        # The URDF tree: the world to the root link, each movable joint's
+        # parent link to its child, the fixed tool mount static.
+        frames = yaml.safe_load(buffer.all_frames_as_yaml())
+        self.assertEqual('world', frames['arm4/base']['parent'])
+        self.assertEqual('arm4/base', frames['arm4/upper_arm']['parent'])
+        self.assertEqual('arm4/upper_arm', frames['arm4/forearm']['parent'])
+        self.assertEqual('arm4/forearm', frames['arm4/tool']['parent'])
         tool = self.get_state('arm4/tool').pose.position
         self.assertAlmostEqual(tool.x, transform.transform.translation.x, delta=1e-3)
         self.assertAlmostEqual(tool.z, transform.transform.translation.z, delta=1e-3)

@@ -418,5 +418,45 @@ TEST(ArticulationTest, GripperLiftsABoxWithoutLettingItSlip) {
   EXPECT_LT(std::abs(end_offset - start_offset), 5e-3);
 }
 
+// A mimic joint follows m q_leader + offset exactly, also when it comes
+// before its leader: here two horizontal slides, the first mimicking the
+// second (m = -1, offset 0.01 m), the second driven at 0.1 m/s.
+TEST(ArticulationTest, MimicJointFollowsItsLeaderWhicheverComesFirst) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Anchor(), Anchor()};
+  JointDef mimic = Slider("mimic", 0, 1, Vec3::Zero(), Vec3::UnitX());
+  mimic.mimic_joint = 1;
+  mimic.mimic_multiplier = -1.0;
+  mimic.mimic_offset = 0.01;
+  def.joints = {mimic, Slider("leader", 0, 2, Vec3(0, 1, 0), Vec3::UnitX())};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  JointCommand drive;
+  drive.mode = JointCommandMode::kVelocity;
+  drive.velocity = 0.1;
+  ASSERT_TRUE(world.SetJointCommand(id, 1, drive).ok());
+  EXPECT_FALSE(world.SetJointCommand(id, 0, drive).ok());  // a mimic takes no command
+  for (int step = 0; step < 240; ++step) world.Step();
+  const std::vector<JointState> states = world.GetJointStates(id);
+  EXPECT_NEAR(states[1].position, 0.1, 1e-3);
+  EXPECT_NEAR(states[0].position, -states[1].position + 0.01, 1e-12);
+  EXPECT_NEAR(states[0].velocity, -states[1].velocity, 1e-12);
+  const Vec3 link1 = world.GetPose(world.ArticulationLinks(id)[1]).translation;
+  EXPECT_NEAR(link1.x(), states[0].position, 1e-12);
+
+  // An effort on the leader is exerted by its mimic too: each 1 kg slide
+  // pushed by 5 N moves 1/2 (5 / 1) t^2 in t = 0.4 s.
+  World pushed = MakeWorld();
+  const ArticulationId pair = pushed.CreateArticulation(def).value();
+  JointCommand push;
+  push.mode = JointCommandMode::kEffort;
+  push.effort = 5.0;
+  ASSERT_TRUE(pushed.SetJointCommand(pair, 1, push).ok());
+  for (int step = 0; step < 96; ++step) pushed.Step();
+  EXPECT_NEAR(pushed.GetJointStates(pair)[1].position, 0.5 * 5.0 * 0.4 * 0.4, 1e-9);
+  EXPECT_NEAR(pushed.GetJointStates(pair)[0].effort, -5.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::physics::testing

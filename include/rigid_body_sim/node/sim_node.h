@@ -187,6 +187,8 @@ class SimNode {
   void FillPeriodicLocked(Outbox* outbox);
   void FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const;
   tf2_msgs::TFMessage ModelTfLocked(const Model& model) const;
+  void AppendModelTfLocked(const Model& model, const ros::Time& stamp,
+                           tf2_msgs::TFMessage* tf) const;
   tf2_msgs::TFMessage StaticTfLocked() const;
   void LogStatusLocked(Clock::time_point now);
   void CloseDiagnosticsWindowLocked(Clock::time_point now);

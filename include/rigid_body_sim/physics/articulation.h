@@ -36,8 +36,8 @@ struct JointDef {
   double velocity_limit = std::numeric_limits<double>::infinity();  // rad/s or m/s, > 0
   double damping = 0.0;   // N m s/rad or N s/m, >= 0: torque -damping * velocity
   double friction = 0.0;  // N m or N, >= 0: Coulomb friction in the joint
-  // Index of the joint this one mimics, or -1: position = multiplier *
-  // leader + offset, so it adds no degree of freedom.
+  // Index of the joint this one mimics (one that mimics none), or -1:
+  // position = multiplier * leader + offset, so it adds no degree of freedom.
   int mimic_joint = -1;
   double mimic_multiplier = 1.0;
   double mimic_offset = 0.0;  // rad or m
