@@ -44,7 +44,9 @@ class TimedWorld : public BaseWorld {
   void ResetTimes() { times_ = StageTimes(); }
   const StageTimes& times() const { return times_; }
 
-  void updateAabbs() override { Timed(&times_.broad_phase_ms, [&] { BaseWorld::updateAabbs(); }); }
+  void updateAabbs() override {
+    Timed(&times_.broad_phase_ms, [&] { BaseWorld::updateAabbs(); });
+  }
   void computeOverlappingPairs() override {
     Timed(&times_.broad_phase_ms, [&] { BaseWorld::computeOverlappingPairs(); });
   }

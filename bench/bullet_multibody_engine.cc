@@ -130,8 +130,7 @@ void BulletMultiBodyEngine::AddArticulation(const BenchArticulation& articulatio
                                             const BulletSleep& sleep) {
   const BenchLink& base = articulation.links[0];
   const int link_count = static_cast<int>(articulation.joints.size());
-  auto body = std::make_unique<btMultiBody>(link_count, base.mass,
-                                            ToBullet(base.inertia_diagonal),
+  auto body = std::make_unique<btMultiBody>(link_count, base.mass, ToBullet(base.inertia_diagonal),
                                             /*fixedBase=*/true, /*canSleep=*/!sleep.like_ours);
   Pose world_from_base_com = articulation.world_from_base;
   world_from_base_com.translation = articulation.world_from_base * base.center_of_mass;
@@ -178,8 +177,7 @@ void BulletMultiBodyEngine::AddArticulation(const BenchArticulation& articulatio
   multi_bodies_.push_back(std::move(body));
 }
 
-void BulletMultiBodyEngine::AddColliders(const BenchArticulation& articulation,
-                                         btMultiBody* body) {
+void BulletMultiBodyEngine::AddColliders(const BenchArticulation& articulation, btMultiBody* body) {
   for (int j = 0; j < body->getNumLinks(); ++j) {
     const BenchLink& link = articulation.links[j + 1];
     if (!link.has_box) continue;

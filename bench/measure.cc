@@ -131,8 +131,8 @@ RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& setti
   RunResult result;
   result.steps = static_cast<int>(std::lround(scene.seconds / kTimeStep));
   result.rows_per_point = engine->RowsPerPoint();
-  const int window_steps = std::min(
-      result.steps, static_cast<int>(std::lround(settings.window_seconds / kTimeStep)));
+  const int window_steps =
+      std::min(result.steps, static_cast<int>(std::lround(settings.window_seconds / kTimeStep)));
   const bool articulated = !scene.articulations.empty();
   MotorSchedule motors(scene);
   ApexTracker apex;
@@ -157,8 +157,8 @@ RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& setti
       result.joint_separation = std::max(result.joint_separation, engine->JointAnchorSeparation());
     }
     if (scene.driven_joint >= 0) {
-      result.driven_swept = std::max(result.driven_swept,
-                                     engine->JointPosition(scene.driven_joint) - driven_start);
+      result.driven_swept =
+          std::max(result.driven_swept, engine->JointPosition(scene.driven_joint) - driven_start);
       result.driven_commanded = std::max(result.driven_commanded, motors.commanded());
     }
     if (scene.kind == SceneKind::kBounce) {
@@ -246,12 +246,16 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
   // Each quality figure is the median over the runs on its own, so that it
   // does not depend on which run the machine happened to run fastest; the
   // times and the stage profile are those of the median run by time.
-  constexpr double RunResult::*kQualityFigures[] = {
-      &RunResult::final_kinetic_energy, &RunResult::final_penetration,
-      &RunResult::peak_penetration,     &RunResult::drift,
-      &RunResult::apex,                 &RunResult::slide,
-      &RunResult::joint_separation,     &RunResult::boxes_moved,
-      &RunResult::driven_swept,         &RunResult::driven_commanded};
+  constexpr double RunResult::*kQualityFigures[] = {&RunResult::final_kinetic_energy,
+                                                    &RunResult::final_penetration,
+                                                    &RunResult::peak_penetration,
+                                                    &RunResult::drift,
+                                                    &RunResult::apex,
+                                                    &RunResult::slide,
+                                                    &RunResult::joint_separation,
+                                                    &RunResult::boxes_moved,
+                                                    &RunResult::driven_swept,
+                                                    &RunResult::driven_commanded};
   std::vector<double> medians;
   for (double RunResult::*figure : kQualityFigures) {
     std::vector<double> values;

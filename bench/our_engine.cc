@@ -194,8 +194,8 @@ class OurEngine : public Engine {
     double separation = 0.0;
     for (const OurJoint& joint : joints_) {
       const Vec3 on_parent = world_->GetPose(joint.parent) * joint.parent_offset;
-      separation = std::max(separation,
-                            (on_parent - world_->GetPose(joint.child).translation).norm());
+      separation =
+          std::max(separation, (on_parent - world_->GetPose(joint.child).translation).norm());
     }
     return separation;
   }

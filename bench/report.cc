@@ -117,8 +117,8 @@ std::string Ratio(double ratio) {
 
 void PrintTableHeader() {
   std::printf("%-12s %-15s %6s %6s %26s %9s %8s %8s %9s %9s %11s %7s  %s\n", "scene", "engine",
-              "bodies", "sim s", "ms/step med [min, max]", "awake ms", "ours/it", "awake",
-              "KE J", "pen mm", "peak pen mm", "RSS MB", "quality");
+              "bodies", "sim s", "ms/step med [min, max]", "awake ms", "ours/it", "awake", "KE J",
+              "pen mm", "peak pen mm", "RSS MB", "quality");
 }
 
 void PrintSceneRows(const Scene& scene, const std::vector<Summary>& summaries) {
@@ -130,8 +130,7 @@ void PrintSceneRows(const Scene& scene, const std::vector<Summary>& summaries) {
         summary.ms_median, summary.ms_min, summary.ms_max, summary.awake_ms_median,
         Ratio(summary.ours_over_this).c_str(), Ratio(summary.ours_over_this_awake).c_str(),
         summary.median.final_kinetic_energy, 1e3 * summary.median.final_penetration,
-        1e3 * summary.median.peak_penetration, summary.peak_rss_kb / 1024.0,
-        quality.text.c_str());
+        1e3 * summary.median.peak_penetration, summary.peak_rss_kb / 1024.0, quality.text.c_str());
   }
   std::fflush(stdout);
 }
@@ -180,9 +179,8 @@ void PrintScaling(const Rows& rows, double window_seconds) {
   for (int e = 0; e < 2; ++e) {
     const RunResult& small = (*pile_1000)[e].median;
     const RunResult& large = (*pile_4000)[e].median;
-    std::printf(" %s %.3f -> %.3f ms, x%.2f;", (*pile_1000)[e].engine.c_str(),
-                small.window_step_ms, large.window_step_ms,
-                large.window_step_ms / small.window_step_ms);
+    std::printf(" %s %.3f -> %.3f ms, x%.2f;", (*pile_1000)[e].engine.c_str(), small.window_step_ms,
+                large.window_step_ms, large.window_step_ms / small.window_step_ms);
   }
   // The same per step with contacts to solve: the larger pile takes longer
   // to settle, and an engine that puts the smaller one to sleep within the
@@ -215,9 +213,9 @@ const std::vector<std::string>& CsvColumns() {
       "ours_over_this_ms_per_step", "ours_over_this_ms_per_awake_step", "awake_seconds",
       "final_kinetic_energy_j", "final_penetration_m", "bounce_apex_m", "bounce_apex_error",
       "incline_slide_m", "incline_error", "joint_separation_m", "boxes_moved",
-      "driven_joint_swept_rad", "driven_joint_commanded_rad", "broad_phase_ms",
-      "narrow_phase_ms", "solver_ms", "integrator_ms", "solver_ns_per_row_iteration",
-      "peak_rss_kb", "contact_seconds", "ms_per_contact_step"};
+      "driven_joint_swept_rad", "driven_joint_commanded_rad", "broad_phase_ms", "narrow_phase_ms",
+      "solver_ms", "integrator_ms", "solver_ns_per_row_iteration", "peak_rss_kb", "contact_seconds",
+      "ms_per_contact_step"};
   return kColumns;
 }
 

@@ -160,7 +160,6 @@ Scene MakeIncline(double degrees) {
   return scene;
 }
 
-
 namespace {
 
 // chain_30's links: a point mass at the end of a massless 0.1 m rod (a
@@ -192,8 +191,8 @@ Scene MakeChain(int links, double seconds) {
     chain.links.push_back(RodLink(i == links ? 100.0 : 0.1, kLength));
     // The first joint at the anchor, turned 90 degrees: the chain starts
     // horizontal along -x.
-    chain.joints.push_back(Revolute(i - 1, Vec3(0.0, 0.0, i == 1 ? 0.0 : -kLength),
-                                    Vec3::UnitY(), i == 1 ? kPi / 2 : 0.0));
+    chain.joints.push_back(Revolute(i - 1, Vec3(0.0, 0.0, i == 1 ? 0.0 : -kLength), Vec3::UnitY(),
+                                    i == 1 ? kPi / 2 : 0.0));
   }
   chain.motors.resize(chain.joints.size());
   scene.articulations.push_back(chain);

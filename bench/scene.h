@@ -58,7 +58,7 @@ struct BenchLink {
 // `parent_offset` and turned by the joint angle about `axis` (both in the
 // parent frame; the frames agree at angle 0).
 struct BenchJoint {
-  int parent = 0;  // index into BenchArticulation::links, below the child's
+  int parent = 0;                     // index into BenchArticulation::links, below the child's
   Vec3 parent_offset = Vec3::Zero();  // m
   Vec3 axis = Vec3::UnitY();          // unit
   double position = 0.0;              // rad, initial
