@@ -37,6 +37,48 @@ enum class SceneKind {
   kPyramid,  // drift of the top box: distance from its start (it should not move)
   kBounce,   // first apex of the sphere against e^2 h
   kIncline,  // distance slid along the slope against 1/2 g (sin - mu cos) t^2
+  kChain,    // largest joint anchor separation over the run (it should be ~0)
+  kArmPush,  // boxes the arm pushed, and how far its driven joint turned
+};
+
+// A link of an articulation: a rigid body in its link frame, which the
+// joint from its parent moves; inertia diagonal in the link frame.
+struct BenchLink {
+  double mass = 1.0;                     // kg
+  Vec3 center_of_mass = Vec3::Zero();    // m, link frame
+  Vec3 inertia_diagonal = Vec3::Ones();  // kg m^2, about the centre of mass
+  // A box collision shape centred on the centre of mass, its axes along the
+  // link frame's.
+  bool has_box = false;
+  Vec3 box_size = Vec3::Ones();  // m, full edge lengths
+  BenchMaterial material;
+};
+
+// A revolute joint: the child link frame is the parent link frame moved by
+// `parent_offset` and turned by the joint angle about `axis` (both in the
+// parent frame; the frames agree at angle 0).
+struct BenchJoint {
+  int parent = 0;                     // index into BenchArticulation::links, below the child's
+  Vec3 parent_offset = Vec3::Zero();  // m
+  Vec3 axis = Vec3::UnitY();          // unit
+  double position = 0.0;              // rad, initial
+  double effort_limit = 1e9;          // N m, the motor's
+};
+
+// One piecewise-constant velocity command for a joint's motor.
+struct MotorPhase {
+  double from_seconds = 0.0;  // s of simulated time
+  double velocity = 0.0;      // rad/s
+};
+
+// A fixed-base tree of revolute joints; joint j moves links[j + 1]. The
+// base has no collision shape.
+struct BenchArticulation {
+  Pose world_from_base;
+  std::vector<BenchLink> links;  // links[0] is the base, fixed to the world
+  std::vector<BenchJoint> joints;
+  // Velocity motors, per joint: none (limp) or phases in time order.
+  std::vector<std::vector<MotorPhase>> motors;
 };
 
 struct Scene {
@@ -51,6 +93,9 @@ struct Scene {
   int top_body = -1;           // index of the body whose drift is reported
   double drop_height = 0.0;    // m, bounce: fall of the sphere's lowest point
   double slope_degrees = 0.0;  // incline: slope angle
+  // Articulated scenes: one articulation beside the free bodies.
+  std::vector<BenchArticulation> articulations;
+  int driven_joint = -1;  // arm: the joint whose swept angle is reported
 };
 
 // pile_N: unit boxes (1 m, 1 kg, mu 0.5, e 0) in a square grid of
@@ -66,6 +111,14 @@ Scene MakePyramid(int rows, double seconds);
 Scene MakeBounce();
 // incline: a unit box (1 kg, mu 0.5) at rest on a slope of `degrees`, for 2 s.
 Scene MakeIncline(double degrees);
+// chain_30: 30 links of 0.1 m and 0.1 kg (point masses at their ends) and a
+// 100 kg tip, hinged about y, released horizontal from a fixed base 3.5 m up,
+// swinging for 10 s, with no collision shapes.
+Scene MakeChain(int links, double seconds);
+// arm_push_100: a fixed-base arm (yaw, shoulder and elbow, box links) whose
+// yaw motor sweeps it through 100 boxes of 0.1 m on the ground and back
+// (scene.cc); shoulder and elbow motors hold them still.
+Scene MakeArmPush(int boxes, double seconds);
 
 }  // namespace rigid_body_sim::bench
 
