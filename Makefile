@@ -18,7 +18,7 @@ CMAKE_ARGS ?=
 CATKIN := catkin_make -C $(WS) -DPYTHON_EXECUTABLE=/usr/bin/python3 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_ARGS)
 
-.PHONY: demo test deps build test-sanitize test-tsan fuzz bench clean format
+.PHONY: demo test deps build test-sanitize test-tsan fuzz bench clean format soak
 
 # The demo scene without rviz for DEMO_SECONDS of real time, showing the
 # node's log (its status line comes every 5 s). Succeeds when the node
@@ -154,6 +154,21 @@ bench: deps
 	python3 $(ROOT)/bench/plot.py $(ROOT)/bench/results/latest.csv $(ROOT)/bench/results/ms_per_step.png
 	@echo "[bench] ours against Bullet, wall clock and per awake step (bench/ratios.py):"
 	@python3 $(ROOT)/bench/ratios.py $(ROOT)/bench/results/latest.csv
+
+# A soak of the node (test/soak/soak.py): spawn, delete, reset, wrench,
+# joint and step churn for SOAK_SECONDS on a master of its own; fails on a
+# refused well-formed request, a dead node, or RSS growth above 5 % after a
+# one-minute warm-up.
+SOAK_SECONDS ?= 3600
+SOAK_PORT ?= 11397
+soak: build
+	@set +e; source $(WS)/devel/setup.bash; export ROS_MASTER_URI=http://localhost:$(SOAK_PORT); \
+	  roslaunch -p $(SOAK_PORT) rigid_body_sim sim.launch paused:=true > $(WS)/soak_node.log 2>&1 & \
+	  launch=$$!; \
+	  python3 $(ROOT)/test/soak/soak.py --seconds $(SOAK_SECONDS); status=$$?; \
+	  kill -INT $$launch; wait $$launch; \
+	  grep -E "\[ERROR\]|\[FATAL\]" $(WS)/soak_node.log && status=1; \
+	  exit $$status
 
 clean:
 	rm -rf $(WS) $(WS_TSAN) $(ROOT)/build

@@ -7,6 +7,7 @@
 
 #include "physics/integrator.h"
 #include "physics/narrow_phase.h"
+#include "physics/shape_bounds.h"
 #include "physics/union_find.h"
 #include "physics/world_impl.h"
 
@@ -29,6 +30,10 @@ struct PairSweep {
   int shape_a = 0;
   int shape_b = 0;
   double gap_cap = 0.0;  // m, beyond anything the step can reach
+  // m, the radii of spheres about the two shapes' origins that hold them;
+  // infinite for a half-space.
+  double radius_a = 0.0;
+  double radius_b = 0.0;
 
   static Pose WorldFromBodyAt(const BodyPath& path, const Body& body, double t) {
     const Pose world_from_principal = path.dt > 0.0 ? path.At(t) : body.WorldFromPrincipal();
@@ -45,6 +50,18 @@ struct PairSweep {
     input.contact_distance = contact_distance;
     return input;
   }
+  // A lower bound on the gap at time t, from the two shapes' bounding
+  // spheres: a test of a few flops that lets the search skip the samples of
+  // a fast body's path far from the other body, where a full test (a
+  // cylinder against a hull of many edges) would cost thousands of times
+  // more.
+  double SphereGapAt(double t) const {
+    const Vec3 a_world =
+        WorldFromBodyAt(*path_a, *a, t) * a->shapes[shape_a].body_from_shape.translation;
+    const Vec3 b_world =
+        WorldFromBodyAt(*path_b, *b, t) * b->shapes[shape_b].body_from_shape.translation;
+    return (a_world - b_world).norm() - radius_a - radius_b;
+  }
   // The gap at time t: the nearest manifold point, at most gap_cap.
   double GapAt(double t) const {
     ContactManifold manifold;
@@ -57,6 +74,12 @@ struct PairSweep {
     return gap;
   }
 };
+
+// m; the radius of a sphere about the shape's origin that holds it.
+double ShapeRadius(const ShapeGeometry& geometry) {
+  if (std::holds_alternative<HalfSpace>(geometry)) return std::numeric_limits<double>::infinity();
+  return ShapeBoundingRadius(geometry, Vec3::Zero());
+}
 
 // Times with gap(low) > target_gap >= gap(high).
 struct ImpactBracket {
@@ -243,7 +266,9 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* appr
                         &bodies_[pair->body_b],
                         pair->shape_a,
                         pair->shape_b,
-                        std::max(start_gap, 0.0) + reach + settings_.contact_margin};
+                        std::max(start_gap, 0.0) + reach + settings_.contact_margin,
+                        ShapeRadius(bodies_[pair->body_a].shapes[pair->shape_a].geometry),
+                        ShapeRadius(bodies_[pair->body_b].shapes[pair->shape_b].geometry)};
   // Most pairs that get here end the step still apart, such as boxes side
   // by side with a gap below their manifold's reuse error. Asking only
   // whether they are apart by more than target_gap at the end lets the
@@ -259,7 +284,8 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* appr
   ImpactBracket bracket{0.0, start_gap, -1.0, 0.0};
   for (int k = 1; k <= samples; ++k) {
     const double t = dt * k / samples;
-    const double gap = sweep.GapAt(t);
+    const double bound = sweep.SphereGapAt(t);
+    const double gap = bound > target_gap ? bound : sweep.GapAt(t);
     if (gap <= target_gap) {
       bracket.high = t;
       bracket.gap_high = gap;
