@@ -39,10 +39,16 @@ class OurEngine : public Engine {
     physics::BodyDef ground;
     ground.is_static = true;
     ground.world_from_body = scene.world_from_ground;
-    physics::ShapeDef half_space;
-    half_space.geometry = physics::HalfSpace{};
-    half_space.material = ToMaterial(scene.ground_material);
-    ground.shapes.push_back(half_space);
+    physics::ShapeDef ground_shape;
+    ground_shape.material = ToMaterial(scene.ground_material);
+    if (scene.terrain.triangles.empty()) {
+      ground_shape.geometry = physics::HalfSpace{};
+    } else {
+      ground.world_from_body = Pose::Identity();
+      ground_shape.geometry =
+          physics::StaticMesh{physics::CollisionMesh::Make(scene.terrain).value()};
+    }
+    ground.shapes.push_back(ground_shape);
     world_->CreateBody(ground).value();
 
     // Boxes of one size share one polyhedron, as a user's meshes would.

@@ -77,7 +77,11 @@ struct RunResult {
   double drift = 0.0;                 // m, top box (SceneKind)
   double apex = 0.0;                  // m, bounce: first apex above the resting height
   double slide = 0.0;                 // m, incline: distance slid down the slope
-  long peak_rss_kb = 0;               // filled in by the parent
+  // Terrain: s until no body moved faster than 0.05 m/s (the sleep
+  // threshold) any more, and the bodies whose centre ended below the surface.
+  double settle_time = 0.0;
+  double below_surface = 0.0;
+  long peak_rss_kb = 0;  // filled in by the parent
 };
 
 struct Summary {
@@ -122,6 +126,7 @@ RunResult RunScene(const Scene& scene, bool bullet, const RunSettings& settings)
   bool rose = false;
   bool apex_found = false;
   double highest = -1e300;
+  int last_moving_step = -1;
   using Clock = std::chrono::steady_clock;
   for (int step = 0; step < result.steps; ++step) {
     const Clock::time_point start = Clock::now();
@@ -145,6 +150,14 @@ RunResult RunScene(const Scene& scene, bool bullet, const RunSettings& settings)
       }
     }
     result.peak_penetration = std::max(result.peak_penetration, engine->MaxPenetration());
+    if (scene.kind == SceneKind::kTerrain) {
+      for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i) {
+        if (engine->LinearVelocity(i).norm() > 0.05) {
+          last_moving_step = step;
+          break;
+        }
+      }
+    }
     if (scene.kind == SceneKind::kBounce && !apex_found) {
       // The first apex: the highest point between leaving the ground and
       // falling again.
@@ -182,6 +195,13 @@ RunResult RunScene(const Scene& scene, bool bullet, const RunSettings& settings)
       result.slide = (top_end - top_start).dot(downhill);
       break;
     }
+    case SceneKind::kTerrain:
+      result.settle_time = (last_moving_step + 1) * kTimeStep;
+      for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i) {
+        const Vec3 position = engine->Position(i);
+        result.below_surface += position.z() < scene.hills.HeightAt(position.x(), position.y());
+      }
+      break;
   }
   result.ok = true;
   return result;
@@ -260,7 +280,9 @@ Summary Summarize(const Scene& scene, bool bullet, std::vector<RunResult> result
                                                     &RunResult::peak_penetration,
                                                     &RunResult::drift,
                                                     &RunResult::apex,
-                                                    &RunResult::slide};
+                                                    &RunResult::slide,
+                                                    &RunResult::settle_time,
+                                                    &RunResult::below_surface};
   std::vector<double> medians;
   for (double RunResult::*figure : kQualityFigures) {
     std::vector<double> values;
@@ -343,6 +365,10 @@ Quality SceneQuality(const Scene& scene, const RunResult& result) {
       std::snprintf(text, sizeof(text), "slid %.2f mm, expected 0 (%s)", 1e3 * result.slide,
                     correct ? "sticks, right" : "WRONG: slides");
     }
+  } else if (scene.kind == SceneKind::kTerrain) {
+    std::snprintf(text, sizeof(text), "all at rest after %.2f s, %d below the surface",
+                  result.settle_time, static_cast<int>(result.below_surface));
+    quality.value = result.settle_time;
   } else {
     std::snprintf(text, sizeof(text), "top-box drift %.4f m", result.drift);
     quality.value = result.drift;
@@ -442,10 +468,19 @@ double RowCostNs(const RunResult& result) {
 // seconds: 10 s, except the two largest scenes, which --scale shortens.
 std::vector<Scene> SelectScenes(const Options& options) {
   std::vector<Scene> scenes = {
-      MakePile(100, 10.0),   MakePile(1000, 10.0),  MakePile(4000, 10.0 * options.scale),
-      MakePyramid(20, 10.0), MakePyramid(40, 10.0), MakePyramid(90, 10.0 * options.scale),
-      MakeBounce(),          MakeIncline(20.0),     MakeIncline(25.0),
-      MakeIncline(28.0),     MakeIncline(35.0),
+      MakePile(100, 10.0),
+      MakePile(1000, 10.0),
+      MakePile(4000, 10.0 * options.scale),
+      MakePyramid(20, 10.0),
+      MakePyramid(40, 10.0),
+      MakePyramid(90, 10.0 * options.scale),
+      MakeBounce(),
+      MakeIncline(20.0),
+      MakeIncline(25.0),
+      MakeIncline(28.0),
+      MakeIncline(35.0),
+      MakeTerrain(100, 100000, 10.0),
+      MakeFlatTerrain(100, 10.0),
   };
   if (!options.only.empty()) {
     scenes.erase(std::remove_if(scenes.begin(), scenes.end(),
@@ -599,7 +634,7 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
          "final_penetration_m,peak_penetration_m,top_box_drift_m,bounce_apex_m,"
          "bounce_apex_error,incline_slide_m,incline_error,broad_phase_ms,narrow_phase_ms,"
          "solver_ms,integrator_ms,solver_ns_per_row_iteration,peak_rss_kb,contact_seconds,"
-         "ms_per_contact_step\n";
+         "ms_per_contact_step,terrain_settle_s,terrain_below_surface\n";
   std::map<std::string, const Scene*> scene_by_name;
   for (const Scene& scene : scenes) scene_by_name[scene.name] = &scene;
   for (const auto& [ours, bullet] : rows) {
@@ -623,7 +658,10 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
           << (scene.kind == SceneKind::kIncline ? std::to_string(quality.value) : "") << ','
           << result.broad_phase_ms << ',' << result.narrow_phase_ms << ',' << result.solver_ms
           << ',' << result.integrator_ms << ',' << RowCostNs(result) << ',' << summary->peak_rss_kb
-          << ',' << result.contact_steps * kTimeStep << ',' << ContactStepMs(result) << '\n';
+          << ',' << result.contact_steps * kTimeStep << ',' << ContactStepMs(result) << ','
+          << (scene.kind == SceneKind::kTerrain ? std::to_string(result.settle_time) : "") << ','
+          << (scene.kind == SceneKind::kTerrain ? std::to_string(result.below_surface) : "")
+          << '\n';
     }
   }
 }

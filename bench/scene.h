@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "rigid_body_sim/physics/mass_properties.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::bench {
@@ -37,6 +38,15 @@ enum class SceneKind {
   kPyramid,  // drift of the top box: distance from its start (it should not move)
   kBounce,   // first apex of the sphere against e^2 h
   kIncline,  // distance slid along the slope against 1/2 g (sin - mu cos) t^2
+  kTerrain,  // time until every body is at rest, and bodies that fell through
+};
+
+// The hills of the terrain scenes: z = amplitude sin(x / wavelength)
+// cos(y / wavelength), m.
+struct Hills {
+  double amplitude = 0.0;
+  double wavelength = 1.0;
+  double HeightAt(double x, double y) const;
 };
 
 struct Scene {
@@ -51,6 +61,10 @@ struct Scene {
   int top_body = -1;           // index of the body whose drift is reported
   double drop_height = 0.0;    // m, bounce: fall of the sphere's lowest point
   double slope_degrees = 0.0;  // incline: slope angle
+  // When it has triangles, the ground is this static mesh (world frame)
+  // instead of the half-space, sampling `hills`.
+  physics::TriangleMesh terrain;
+  Hills hills;
 };
 
 // pile_N: unit boxes (1 m, 1 kg, mu 0.5, e 0) in a square grid of
@@ -66,6 +80,13 @@ Scene MakePyramid(int rows, double seconds);
 Scene MakeBounce();
 // incline: a unit box (1 kg, mu 0.5) at rest on a slope of `degrees`, for 2 s.
 Scene MakeIncline(double degrees);
+// terrain_N: N unit boxes (1 kg, mu 0.5) dropped from 1 m above rolling
+// hills (amplitude 0.5 m, wavelength 3 m) made of `triangles` (rounded up
+// to a square grid) over 40 x 40 m, in a square grid 3 m apart, each yawed
+// 0.3 rad more than the last. terrain_flat_N: the same drop onto the flat
+// half-space, the reference for the terrain's cost.
+Scene MakeTerrain(int count, int triangles, double seconds);
+Scene MakeFlatTerrain(int count, double seconds);
 
 }  // namespace rigid_body_sim::bench
 
