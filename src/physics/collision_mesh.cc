@@ -129,11 +129,9 @@ void CollisionMesh::FindNeighbours() {
     }
   }
   std::sort(edges.begin(), edges.end());
-  closed_ = true;
   for (std::size_t begin = 0; begin < edges.size();) {
     std::size_t end = begin + 1;
     while (end < edges.size() && edges[end].first == edges[begin].first) ++end;
-    closed_ = closed_ && end - begin >= 2;
     if (end - begin == 2) {
       for (int side = 0; side < 2; ++side) {
         const int own = edges[begin + side].second;

@@ -86,16 +86,11 @@ ConvexPolyhedron MakePrismTopology() {
 // normal against the adjacent face normals (Mirtich 1998, "V-Clip: Fast and
 // Robust Polyhedral Collision Detection", ACM TOG 17(3), section 3.1, for
 // the regions; Bullet's btInternalEdgeUtility for the use on meshes).
-bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, bool back,
-                    const Vec3& on_triangle, const Vec3& normal) {
+bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, const Vec3& on_triangle,
+                    const Vec3& normal) {
   const CollisionMesh::Triangle& triangle = mesh.triangles()[triangle_index];
-  const Vec3 front = back ? Vec3(-triangle.normal) : triangle.normal;
+  const Vec3& front = triangle.normal;
   if (normal.dot(front) >= kFaceNormalCosine) return true;
-  const auto fold_seen = [&](int k) {
-    const Fold fold = triangle.edge_folds[k];
-    if (!back) return fold;
-    return fold == Fold::kConvex ? Fold::kConcave : fold == Fold::kConcave ? Fold::kConvex : fold;
-  };
   int nearest = 0;
   double nearest_distance = std::numeric_limits<double>::infinity();
   double nearest_t = 0.0;
@@ -111,25 +106,29 @@ bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, bool back,
     }
   }
   const auto edge_open = [&](int k) {
-    const Fold fold = fold_seen(k);
+    const Fold fold = triangle.edge_folds.at(k);
     return fold == Fold::kBoundary || fold == Fold::kConvex;
   };
   if (nearest_t <= kVertexFraction || nearest_t >= 1.0 - kVertexFraction) {
     const int other = nearest_t <= kVertexFraction ? (nearest + 2) % 3 : (nearest + 1) % 3;
     return edge_open(nearest) || edge_open(other);
   }
-  const Fold fold = fold_seen(nearest);
+  const Fold fold = triangle.edge_folds.at(nearest);
   if (fold == Fold::kBoundary) return true;
   if (fold != Fold::kConvex) return false;
-  const Vec3 neighbour =
-      back ? Vec3(-triangle.neighbour_normals[nearest]) : triangle.neighbour_normals[nearest];
+  const Vec3& neighbour = triangle.neighbour_normals[nearest];
   const double bound = front.dot(neighbour) - kRegionSlack;
   return normal.dot(front) >= bound && normal.dot(neighbour) >= bound;
 }
 
-// One group of contacts with similar normals.
+// One group of contacts with similar normals: its first member's normal
+// decides who joins, and the sum of the members' normals, one per point,
+// is its normal. The mean keeps a body lying across a gentle ridge (two
+// facets a few degrees apart) from being pushed along one facet's normal
+// and then the other's as its deepest point changes side, which rocked it.
 struct Group {
   Vec3 normal_world = Vec3::UnitZ();
+  Vec3 normal_sum = Vec3::Zero();
   int first_triangle = 0;
   double deepest = std::numeric_limits<double>::infinity();
   std::vector<ContactPoint> points;
@@ -150,11 +149,13 @@ void AddToGroups(const ContactManifold& manifold, int triangle, std::vector<Grou
     if (*group_count == static_cast<int>(groups->size())) groups->emplace_back();
     group = &(*groups)[(*group_count)++];
     group->normal_world = manifold.normal_world;
+    group->normal_sum = Vec3::Zero();
     group->first_triangle = triangle;
     group->deepest = std::numeric_limits<double>::infinity();
     group->points.clear();
   }
   group->first_triangle = std::min(group->first_triangle, triangle);
+  group->normal_sum += manifold.point_count * manifold.normal_world;
   for (int i = 0; i < manifold.point_count; ++i) {
     ContactPoint point = manifold.points[i];
     // Points of different triangles must not share an id: the triangle goes
@@ -164,6 +165,20 @@ void AddToGroups(const ContactManifold& manifold, int triangle, std::vector<Grou
     group->deepest = std::min(group->deepest, point.separation);
     group->points.push_back(point);
   }
+}
+
+// min over the convex shape of n . x, for a unit n in the shape's frame:
+// -r for a sphere, -h |n_z| - r sqrt(1 - n_z^2) for a cylinder (its support,
+// Ericson 2005, section 5.1), the support vertex's for a polyhedron.
+double LowestAlong(const ShapeGeometry& convex, const Vec3& normal_shape) {
+  if (const auto* sphere = std::get_if<Sphere>(&convex)) return -sphere->radius;
+  if (const auto* cylinder = std::get_if<Cylinder>(&convex)) {
+    const double along = normal_shape.z();
+    return -cylinder->half_length * std::abs(along) -
+           cylinder->radius * std::sqrt(std::max(0.0, 1.0 - along * along));
+  }
+  const auto& polyhedron = *std::get<std::shared_ptr<const ConvexPolyhedron>>(convex);
+  return normal_shape.dot(polyhedron.vertices[polyhedron.SupportVertex(-normal_shape)]);
 }
 
 // The centre of a convex shape in its own frame.
@@ -205,12 +220,13 @@ void MakeTrianglePrism(const std::array<Vec3, 3>& front_ccw, double depth,
 // The triangles whose boxes come within the contact distance of the convex
 // shape's box (CollisionMesh::QueryBox) are each taken as the prism behind
 // their face, extruded away from the shape by more than the shape's
-// diameter, so that the prism's back never decides a contact. A triangle
-// seen from behind (the shape's centre below its plane) is skipped when the
-// mesh is closed (its back faces the solid's inside: the underside of a
-// bin's floor must not hold up a box resting on the floor's top, 5 mm
-// above) and turned over when it is open (a wall of one layer stops bodies
-// from both sides).
+// diameter, so that the prism's back never decides a contact. Triangles
+// collide on their front (normal) side only: one whose plane has the
+// shape's centre behind it is skipped (the underside of a bin's floor must
+// not hold up a box resting on the floor's top, 5 mm above, and the plane
+// of a far triangle of a hillside may pass above a box in the valley), as
+// is one whose plane the shape lies in front of by the contact distance
+// (its support point along -n, which also bounds the gap).
 // Each prism is collided with the convex routines of the narrow phase
 // (separating axes and clipping for polyhedra, exact for spheres and
 // cylinders), and the normal is checked against the Voronoi region of the
@@ -223,79 +239,165 @@ void MakeTrianglePrism(const std::array<Vec3, 3>& front_ccw, double depth,
 // neighbour). Moving the points onto the face instead, as Bullet's
 // btAdjustInternalEdgeContacts does, needs points on the convex shape,
 // which a manifold of shapes still apart does not have. The manifolds are then grouped by
-// normal; the kContactSlots groups with the deepest points are kept, in
-// the order of their first triangle, and each is reduced to four points.
-void CollideConvexMesh(const ConvexMeshPair& pair, MeshContacts* contacts) {
-  thread_local std::vector<int> candidates;
-  thread_local std::vector<Group> groups;
-  thread_local ConvexPolyhedron prism;
-  for (ContactManifold& manifold : contacts->manifolds) manifold.point_count = 0;
-  const CollisionMesh& mesh = *pair.mesh;
-  const Pose mesh_from_convex = pair.world_from_mesh.Inverse() * pair.world_from_convex;
-  const Aabb box = ShapeAabb(*pair.convex, mesh_from_convex).Fattened(pair.contact_distance);
-  candidates.clear();
-  mesh.QueryBox(box.min, box.max, &candidates);
-  // Apart along a box axis by the contact distance: at least that far.
-  contacts->gap = pair.contact_distance;
-  if (candidates.empty()) return;
-  const Vec3 local_center = ShapeCenter(*pair.convex);
-  const Vec3 center_mesh = mesh_from_convex * local_center;
-  const double depth =
-      2.0 * ShapeBoundingRadius(*pair.convex, local_center) + pair.contact_distance;
-  // The prism is owned here; the shared pointer only lends it.
-  const ShapeGeometry prism_geometry =
-      std::shared_ptr<const ConvexPolyhedron>(std::shared_ptr<void>(), &prism);
-  const Mat3 world_from_mesh_rotation = pair.world_from_mesh.rotation.toRotationMatrix();
-  int group_count = 0;
-  double gap = std::numeric_limits<double>::infinity();
-  for (const int t : candidates) {
-    const CollisionMesh::Triangle& triangle = mesh.triangles()[t];
-    const Vec3& v0 = mesh.vertices()[triangle.vertices[0]];
-    const Vec3& v1 = mesh.vertices()[triangle.vertices[1]];
-    const Vec3& v2 = mesh.vertices()[triangle.vertices[2]];
-    const bool back = triangle.normal.dot(center_mesh - v0) < 0.0;
-    if (back && mesh.closed()) continue;
-    MakeTrianglePrism(back ? std::array<Vec3, 3>{v0, v2, v1} : std::array<Vec3, 3>{v0, v1, v2},
-                      depth, &prism);
-    ContactManifold manifold;
+// normal; the kContactSlots groups with the deepest points are kept, the
+// deepest first and the others in the order of their first triangle (so a
+// group keeps its slot from step to step), and each is reduced to four
+// points.
+namespace {
+
+// The triangles near a convex shape and how each one is collided with it.
+class TriangleQuery {
+ public:
+  // A candidate triangle and a lower bound on its separation from the shape.
+  struct Candidate {
+    int triangle = 0;
+    double bound = 0.0;  // m
+  };
+
+  // The triangles whose boxes come within the contact distance of the
+  // shape's box, less those seen from behind, into `candidates`; `gap`
+  // (m) becomes a lower bound on the distance to the others.
+  TriangleQuery(const ConvexMeshPair& pair, std::vector<Candidate>* candidates, double* gap)
+      : pair_(pair),
+        mesh_(*pair.mesh),
+        mesh_from_convex_(pair.world_from_mesh.Inverse() * pair.world_from_convex),
+        world_from_mesh_rotation_(pair.world_from_mesh.rotation.toRotationMatrix()),
+        prism_geometry_(std::shared_ptr<const ConvexPolyhedron>(std::shared_ptr<void>(), &prism_)) {
+    thread_local std::vector<int> found;
+    const Aabb box = ShapeAabb(*pair.convex, mesh_from_convex_).Fattened(pair.contact_distance);
+    found.clear();
+    mesh_.QueryBox(box.min, box.max, &found);
+    // Apart along a box axis by the contact distance: at least that far.
+    *gap = pair.contact_distance;
+    candidates->clear();
+    if (found.empty()) return;
+    *gap = std::numeric_limits<double>::infinity();
+    const Vec3 local_center = ShapeCenter(*pair.convex);
+    const Vec3 center_mesh = mesh_from_convex_ * local_center;
+    depth_ = 2.0 * ShapeBoundingRadius(*pair.convex, local_center) + pair.contact_distance;
+    const Mat3 convex_from_mesh = mesh_from_convex_.rotation.conjugate().toRotationMatrix();
+    for (const int t : found) {
+      const CollisionMesh::Triangle& triangle = mesh_.triangles()[t];
+      const double plane = triangle.normal.dot(mesh_.vertices()[triangle.vertices[0]]);
+      // Seen from behind, or in front of the plane by the contact distance
+      // (the plane's distance bounds the triangle's): no contact.
+      if (triangle.normal.dot(center_mesh) < plane) continue;
+      const double bound = triangle.normal.dot(mesh_from_convex_.translation) +
+                           LowestAlong(*pair.convex, convex_from_mesh * triangle.normal) - plane;
+      if (bound >= pair.contact_distance) {
+        *gap = std::min(*gap, bound);
+        continue;
+      }
+      candidates->push_back({t, bound});
+    }
+  }
+
+  // The manifold of triangle t's prism, true when it has points whose
+  // normal lies in the touched feature's region; else `gap` is lowered to
+  // the separation found, when known.
+  bool Collide(int t, ContactManifold* manifold, double* gap) {
+    const CollisionMesh::Triangle& triangle = mesh_.triangles()[t];
+    MakeTrianglePrism(
+        {mesh_.vertices()[triangle.vertices[0]], mesh_.vertices()[triangle.vertices[1]],
+         mesh_.vertices()[triangle.vertices[2]]},
+        depth_, &prism_);
     CollideStats stats;
-    if (!Collide({pair.convex, pair.world_from_convex, &prism_geometry, pair.world_from_mesh,
-                  pair.contact_distance},
-                 nullptr, &manifold, &stats)) {
-      gap = std::min(gap, stats.gap);
-      continue;
+    if (!physics::Collide({pair_.convex, pair_.world_from_convex, &prism_geometry_,
+                           pair_.world_from_mesh, pair_.contact_distance},
+                          nullptr, manifold, &stats)) {
+      *gap = std::min(*gap, stats.gap);
+      return false;
     }
-    const Vec3 normal_mesh = world_from_mesh_rotation.transpose() * manifold.normal_world;
     int deepest = 0;
-    for (int i = 1; i < manifold.point_count; ++i) {
-      if (manifold.points[i].separation < manifold.points[deepest].separation) deepest = i;
+    for (int i = 1; i < manifold->point_count; ++i) {
+      if (manifold->points[i].separation < manifold->points[deepest].separation) deepest = i;
     }
-    const ContactPoint& point = manifold.points[deepest];
+    const ContactPoint& point = manifold->points[deepest];
     const Vec3 on_triangle =
-        pair.world_from_mesh.Inverse() *
-        (point.position_world - 0.5 * point.separation * manifold.normal_world);
-    if (!NormalInRegion(mesh, t, back, on_triangle, normal_mesh)) continue;
-    AddToGroups(manifold, t, &groups, &group_count);
+        pair_.world_from_mesh.Inverse() *
+        (point.position_world - 0.5 * point.separation * manifold->normal_world);
+    const Vec3 normal_mesh = world_from_mesh_rotation_.transpose() * manifold->normal_world;
+    return NormalInRegion(mesh_, t, on_triangle, normal_mesh);
   }
-  if (group_count == 0) {
-    contacts->gap = gap;
-    return;
+
+ private:
+  const ConvexMeshPair& pair_;
+  const CollisionMesh& mesh_;
+  const Pose mesh_from_convex_;
+  const Mat3 world_from_mesh_rotation_;
+  double depth_ = 0.0;  // m, of the prisms
+  ConvexPolyhedron prism_;
+  // Lends prism_ to the narrow phase; owns nothing.
+  const ShapeGeometry prism_geometry_;
+};
+
+}  // namespace
+
+void CollideConvexMesh(const ConvexMeshPair& pair, MeshContacts* contacts) {
+  thread_local std::vector<TriangleQuery::Candidate> candidates;
+  thread_local std::vector<Group> groups;
+  thread_local std::vector<Group*> kept;
+  for (ContactManifold& manifold : contacts->manifolds) manifold.point_count = 0;
+  double gap = 0.0;
+  TriangleQuery query(pair, &candidates, &gap);
+  int group_count = 0;
+  for (const TriangleQuery::Candidate& candidate : candidates) {
+    ContactManifold manifold;
+    if (query.Collide(candidate.triangle, &manifold, &gap)) {
+      AddToGroups(manifold, candidate.triangle, &groups, &group_count);
+    }
   }
-  std::vector<Group*> kept;
-  kept.reserve(group_count);
+  contacts->gap = gap;
+  if (group_count == 0) return;
+  kept.clear();
   for (int g = 0; g < group_count; ++g) kept.push_back(&groups[g]);
   if (group_count > StaticMesh::kContactSlots) {
     std::partial_sort(kept.begin(), kept.begin() + StaticMesh::kContactSlots, kept.end(),
                       [](const Group* x, const Group* y) { return x->deepest < y->deepest; });
     kept.resize(StaticMesh::kContactSlots);
   }
-  std::sort(kept.begin(), kept.end(),
+  // The deepest group first, so that slot 0 holds the least separation of
+  // all (what CollideConvexMeshDeepest finds along the time-of-impact
+  // search); the others by their first triangle.
+  std::iter_swap(kept.begin(),
+                 std::min_element(kept.begin(), kept.end(), [](const Group* x, const Group* y) {
+                   return x->deepest < y->deepest;
+                 }));
+  std::sort(kept.begin() + 1, kept.end(),
             [](const Group* x, const Group* y) { return x->first_triangle < y->first_triangle; });
   for (std::size_t s = 0; s < kept.size(); ++s) {
     ReduceContactPoints(kept[s]->points.data(), static_cast<int>(kept[s]->points.size()),
-                        kept[s]->normal_world, &contacts->manifolds[s]);
+                        kept[s]->normal_sum.normalized(), &contacts->manifolds[s]);
   }
   contacts->gap = -std::numeric_limits<double>::infinity();
+}
+
+// The candidates in order of their plane bound; a triangle whose bound is
+// not below the deepest separation found so far cannot be deeper (the
+// separation along the face normal is one of the separating-axis test's,
+// and the test takes the largest), so the walk stops there.
+bool CollideConvexMeshDeepest(const ConvexMeshPair& pair, ContactManifold* manifold, double* gap) {
+  thread_local std::vector<TriangleQuery::Candidate> candidates;
+  manifold->point_count = 0;
+  TriangleQuery query(pair, &candidates, gap);
+  std::sort(candidates.begin(), candidates.end(),
+            [](const TriangleQuery::Candidate& x, const TriangleQuery::Candidate& y) {
+              return x.bound < y.bound;
+            });
+  double deepest = std::numeric_limits<double>::infinity();
+  for (const TriangleQuery::Candidate& candidate : candidates) {
+    if (candidate.bound >= deepest) break;
+    ContactManifold found;
+    if (!query.Collide(candidate.triangle, &found, gap)) continue;
+    double least = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < found.point_count; ++i) least = std::min(least, found.points[i].separation);
+    if (least < deepest) {
+      deepest = least;
+      *manifold = found;
+    }
+  }
+  if (manifold->point_count > 0) *gap = -std::numeric_limits<double>::infinity();
+  return manifold->point_count > 0;
 }
 
 namespace {

@@ -25,9 +25,10 @@ struct ConvexMeshPair {
 
 struct MeshContacts {
   // Slot s holds the s-th group of contacts (normals within about 9 degrees
-  // of each other), groups ordered by their first triangle so that a group
-  // keeps its slot from step to step; empty slots have no points. Normals
-  // from the mesh to the convex shape.
+  // of each other): slot 0 the group with the deepest point, the others
+  // ordered by their first triangle so that a group keeps its slot from step
+  // to step; empty slots have no points. Normals from the mesh to the
+  // convex shape.
   std::array<ContactManifold, StaticMesh::kContactSlots> manifolds;
   // m; with no points in any slot, a lower bound on the distance
   // (-infinity when not known).
@@ -36,6 +37,11 @@ struct MeshContacts {
 
 // The contacts of a convex shape with a static mesh, see mesh_collision.cc.
 void CollideConvexMesh(const ConvexMeshPair& pair, MeshContacts* contacts);
+
+// Only the manifold of the deepest triangle contact (any group), for
+// callers that want the least separation: the time-of-impact search and the
+// overlap query. False with no points; `gap` as MeshContacts::gap.
+bool CollideConvexMeshDeepest(const ConvexMeshPair& pair, ContactManifold* manifold, double* gap);
 
 // The prism of a triangle, extruded by `depth` behind its front face, as a
 // polyhedron (reusing `prism`'s storage): the convex piece of the mesh's

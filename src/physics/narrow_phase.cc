@@ -169,15 +169,22 @@ bool CollidePolyhedronHalfSpace(const ConvexPolyhedron& polyhedron, const Pose& 
 }
 
 // A convex shape (A) against slot `mesh.slot` of a static mesh (B): the
-// slot's group of contacts (CollideConvexMesh).
+// slot's group of contacts (CollideConvexMesh). Without `stats` (the
+// time-of-impact search's and FindOverlaps' calls, which want the least
+// separation) slot 0 holds the deepest triangle contact of any group and
+// the other slots nothing (CollideConvexMeshDeepest).
 bool CollideWithMesh(const ShapeGeometry& convex, const Pose& world_from_a, const StaticMesh& mesh,
                      const Pose& world_from_b, double contact_distance, ContactManifold* manifold,
                      CollideStats* stats) {
+  const ConvexMeshPair pair{&convex, world_from_a, mesh.mesh.get(), world_from_b, contact_distance};
+  if (stats == nullptr) {
+    double gap = 0.0;
+    return mesh.slot == 0 && CollideConvexMeshDeepest(pair, manifold, &gap);
+  }
   thread_local MeshContacts contacts;
-  CollideConvexMesh({&convex, world_from_a, mesh.mesh.get(), world_from_b, contact_distance},
-                    &contacts);
+  CollideConvexMesh(pair, &contacts);
   *manifold = contacts.manifolds[mesh.slot];
-  if (stats != nullptr) stats->gap = contacts.gap;
+  stats->gap = contacts.gap;
   return manifold->point_count > 0;
 }
 

@@ -24,7 +24,8 @@ struct CollideInput {
 // contact-defining feature, owned by the caller (may be null; only used for
 // polyhedron pairs); `stats` (may be null) reports whether it was used.
 // Two half-spaces or static meshes never collide (both are static); such a
-// pair is a programmer error. A static mesh gives the manifold of its slot.
+// pair is a programmer error. A static mesh gives the manifold of its slot;
+// called without `stats`, only its deepest contact, in slot 0.
 bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManifold* manifold,
              CollideStats* stats = nullptr);
 

@@ -101,7 +101,6 @@ TEST(StaticMeshIoTest, StaticModelsKeepTriangles) {
     const auto* mesh = std::get_if<physics::StaticMesh>(&fixed->shapes[0].shape.geometry);
     ASSERT_NE(mesh, nullptr);
     EXPECT_EQ(mesh->mesh->triangles().size(), 28u);
-    EXPECT_TRUE(mesh->mesh->closed());
     EXPECT_NEAR(mesh->mesh->upper().z(), 0.2, 1e-7);
     // The link mass is the bins' material: outer box less the cavity, for
     // the shell and for the lid (the shell at a tenth of its height).

@@ -1,6 +1,9 @@
 // Static triangle meshes for concave environments (bins, shelves, tables,
 // terrain): the triangles with their edge adjacency, in a bounding-volume
-// hierarchy built once.
+// hierarchy built once. Triangles collide on their front side, the side
+// their counter-clockwise winding's normal points to: a closed mesh (as
+// mesh files of solids are) from outside, a terrain sheet from above. A
+// wall of one layer stops bodies coming at its front only.
 #ifndef RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
 #define RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
 
@@ -54,11 +57,7 @@ class CollisionMesh {
   // In tree order (leaves hold consecutive triangles), not the input order.
   const std::vector<Triangle>& triangles() const { return triangles_; }
   const std::vector<Node>& nodes() const { return nodes_; }
-  // No edge has a single triangle: the mesh bounds solids (boxes meeting
-  // along an edge count), and its triangles collide on their front (normal)
-  // side only. An open mesh (a terrain sheet, a wall of one layer) collides
-  // on both sides.
-  bool closed() const { return closed_; }
+
   const Vec3& lower() const { return nodes_.front().lower; }
   const Vec3& upper() const { return nodes_.front().upper; }
   // The largest distance of a vertex from `center` (m).
@@ -78,7 +77,6 @@ class CollisionMesh {
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
   std::vector<Node> nodes_;
-  bool closed_ = false;
 };
 
 }  // namespace rigid_body_sim::physics
