@@ -54,6 +54,11 @@ ws-links:
 	  [ "$$name" = build ] || ln -sfn $$entry $(WS)/src/rigid_body_sim/$$name; \
 	done
 	@find $(WS)/src/rigid_body_sim -maxdepth 1 -xtype l -delete
+	@# catkin writes the environment ctest runs the tests in when it first
+	@# configures, and puts only directories that exist then on PYTHONPATH:
+	@# without this one, a fresh clone's Python tests cannot import the
+	@# package's generated messages.
+	@mkdir -p $(WS)/devel/lib/python3/dist-packages
 
 build: deps ws-links
 	@echo "[build] catkin_make in $(WS)"
@@ -121,12 +126,15 @@ fuzz: deps
 	@echo "[fuzz] no crash in $(FUZZERS)"
 
 # The benchmark scenes in our engine and side by side in Bullet (only this
-# build links Bullet), then the component benchmarks and the plot. A plain
-# CMake Release build of the ROS-free core. pile_4000 and pyramid_90
-# simulate BENCH_SCALE x 10 s so that the run stays within minutes.
+# build links Bullet), then the component benchmarks, the plot and the
+# table of ratios. A plain CMake Release build of the ROS-free core.
+# pile_4000 and pyramid_90 simulate BENCH_SCALE x 10 s so that the run
+# stays within minutes.
 BENCH_BUILD := $(ROOT)/build/bench
 BENCH_SCALE ?= 0.2
 BENCH_RUNS ?= 3
+# Comma-separated scene names to run only those (physics_bench --only).
+BENCH_ONLY ?=
 bench: deps
 	cmake -S $(ROOT) -B $(BENCH_BUILD) -DRBS_CORE_ONLY=ON -DRBS_BENCH=ON -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" > /dev/null
@@ -135,6 +143,7 @@ bench: deps
 	mkdir -p $(ROOT)/bench/results
 	@echo "[bench] $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $$(date -u '+%F %H:%M UTC')"
 	$(BENCH_BUILD)/physics_bench --runs $(BENCH_RUNS) --scale $(BENCH_SCALE) \
+	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) \
 	  --csv $(ROOT)/bench/results/latest.csv --hull-bench $(BENCH_BUILD)/hull_bench
 	@if [ -x $(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node ]; then \
 	  source $(WS)/devel/setup.bash && \
@@ -143,6 +152,8 @@ bench: deps
 	$(BENCH_BUILD)/narrow_phase_bench 200000
 	$(BENCH_BUILD)/broad_phase_bench 30
 	python3 $(ROOT)/bench/plot.py $(ROOT)/bench/results/latest.csv $(ROOT)/bench/results/ms_per_step.png
+	@echo "[bench] ours against Bullet, wall clock and per awake step (bench/ratios.py):"
+	@python3 $(ROOT)/bench/ratios.py $(ROOT)/bench/results/latest.csv
 
 clean:
 	rm -rf $(WS) $(WS_TSAN) $(ROOT)/build

@@ -44,6 +44,19 @@ class Engine {
   // points and the iterations of StageTimes, the denominator of the cost per
   // row.
   virtual int RowsPerPoint() const = 0;
+  // Whether every body that can move (every free body, every link but a
+  // fixed base) is awake: the steps in which neither engine is spared work
+  // by sleeping.
+  virtual bool AllMovingBodiesAwake() const = 0;
+
+  // Articulated scenes (Scene::articulations; joints numbered over all of
+  // them in order). m: the largest distance between where a joint's anchor
+  // is on its parent link and where it is on its child link.
+  virtual double JointAnchorSeparation() const = 0;
+  virtual double JointPosition(int joint) const = 0;  // rad
+  // The target of the joint's velocity motor (rad/s), whose torque is capped
+  // at the joint's effort limit.
+  virtual void SetMotorVelocity(int joint, double velocity) = 0;
 };
 
 constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines
@@ -58,9 +71,29 @@ struct OurSettingsOverrides {
   std::optional<bool> interleave_independent_runs;  // the sweeps pair independent runs of rows
 };
 
+// The engines under test: ours; Bullet with its defaults; Bullet with the
+// sleep thresholds of ours (bullet_engine.cc). Bullet's multi-threaded world
+// is left out: Debian's build has no thread-safe Bullet (performance.md).
+enum class EngineKind { kOurs, kBullet, kBulletOurSleep };
+std::string EngineName(EngineKind kind);
+
+// Bullet's sleeping: its defaults, or the thresholds of ours.
+struct BulletSleep {
+  bool like_ours = false;
+  double linear_velocity = 0.0;   // m/s
+  double angular_velocity = 0.0;  // rad/s
+  double time_to_sleep = 0.0;     // s
+};
+
 std::unique_ptr<Engine> MakeOurEngine(const Scene& scene,
                                       const OurSettingsOverrides& overrides = {});
-std::unique_ptr<Engine> MakeBulletEngine(const Scene& scene);
+// btDiscreteDynamicsWorld for scenes of free bodies only.
+std::unique_ptr<Engine> MakeBulletEngine(const Scene& scene, const BulletSleep& sleep);
+// btMultiBodyDynamicsWorld (Featherstone's btMultiBody) for articulated scenes.
+std::unique_ptr<Engine> MakeBulletMultiBodyEngine(const Scene& scene, const BulletSleep& sleep);
+// The engine of `kind`; Bullet's sleep thresholds of ours follow `overrides`.
+std::unique_ptr<Engine> MakeEngine(EngineKind kind, const Scene& scene,
+                                   const OurSettingsOverrides& overrides);
 
 }  // namespace rigid_body_sim::bench
 

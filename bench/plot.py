@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""Plots wall ms per step against body count, log-log, for both engines.
+"""Plots wall ms per step against body count, log-log, for every engine.
 
   bench/plot.py [bench/results/latest.csv] [bench/results/ms_per_step.png]
 
-One line per scene family (pile, pyramid) and engine, from the rows of the
-CSV that physics_bench writes; the error bars span the min and max run.
-Points of scenes simulated for less than 10 s have open markers and a note.
+Left: ms per step, right: ms per awake step (the steps in which every body
+that can move is awake). One line per scene family (pile, pyramid) and
+engine, from the rows of the CSV that physics_bench writes; on the left the
+error bars span the min and max run. Points of scenes simulated for less
+than 10 s have open markers and a note.
 """
 import csv
 import sys
@@ -28,12 +30,14 @@ def main():
             series.setdefault((family, row['engine']), []).append(
                 (int(row['bodies']), float(row['ms_per_step_median']),
                  float(row['ms_per_step_min']), float(row['ms_per_step_max']),
-                 float(row['sim_seconds'])))
+                 float(row['sim_seconds']),
+                 float(row['ms_per_awake_step_median'] or 'nan')))
     if not series:
         sys.exit('no pile or pyramid rows in ' + csv_path)
 
-    figure, axes = plt.subplots(figsize=(7, 5))
-    styles = {'ours': ('tab:blue', 'o'), 'bullet': ('tab:orange', 's')}
+    figure, (wall, awake) = plt.subplots(1, 2, figsize=(12, 5))
+    styles = {'ours': ('tab:blue', 'o'), 'bullet': ('tab:orange', 's'),
+              'bullet_oursleep': ('tab:green', '^')}
     lines = {'pile': '-', 'pyramid': '--'}
     shortened = set()  # sim seconds of the shortened scenes
     for (family, engine), points in sorted(series.items()):
@@ -43,27 +47,33 @@ def main():
         below = [p[1] - p[2] for p in points]
         above = [p[3] - p[1] for p in points]
         color, marker = styles.get(engine, ('gray', 'x'))
-        axes.errorbar(bodies, median, yerr=[below, above], color=color, marker=marker,
+        wall.errorbar(bodies, median, yerr=[below, above], color=color, marker=marker,
                       linestyle=lines[family], capsize=3, label=f'{engine}, {family}')
+        awake.plot(bodies, [p[5] for p in points], color=color, marker=marker,
+                   linestyle=lines[family], label=f'{engine}, {family}')
         # Scenes shortened to keep the run short average over their first
         # seconds only (the landing), not the whole 10 s: open markers, and
         # one note for all of them (labels beside each crowd each other).
         for point in points:
             if point[4] < 10.0:
-                axes.plot(point[0], point[1], marker=marker, markerfacecolor='white',
-                          markeredgecolor=color, linestyle='none', zorder=3)
+                for axes, value in ((wall, point[1]), (awake, point[5])):
+                    axes.plot(point[0], value, marker=marker, markerfacecolor='white',
+                              markeredgecolor=color, linestyle='none', zorder=3)
                 shortened.add(point[4])
-    axes.set_xscale('log')
-    axes.set_yscale('log')
-    axes.set_xlabel('bodies')
-    axes.set_ylabel('wall ms per step (dt = 1/240 s)')
-    axes.set_title('ms per step against body count (median of runs, bars: min to max)')
-    axes.grid(True, which='both', alpha=0.3)
-    axes.legend()
+    for axes, label, title in (
+            (wall, 'wall ms per step (dt = 1/240 s)', 'ms per step (median of runs, bars: min to max)'),
+            (awake, 'wall ms per awake step', 'ms per step with every moving body awake')):
+        axes.set_xscale('log')
+        axes.set_yscale('log')
+        axes.set_xlabel('bodies')
+        axes.set_ylabel(label)
+        axes.set_title(title)
+        axes.grid(True, which='both', alpha=0.3)
+    wall.legend(fontsize=8)
     if shortened:
         seconds = ', '.join(f'{value:g}' for value in sorted(shortened))
-        axes.text(0.98, 0.02, f'open markers: the first {seconds} s only (the landing), not 10 s',
-                  transform=axes.transAxes, ha='right', va='bottom', fontsize=8)
+        wall.text(0.98, 0.02, f'open markers: the first {seconds} s only (the landing), not 10 s',
+                  transform=wall.transAxes, ha='right', va='bottom', fontsize=8)
     figure.tight_layout()
     figure.savefig(png_path, dpi=110)
     print('wrote ' + png_path)

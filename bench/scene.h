@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "rigid_body_sim/physics/mass_properties.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::bench {
@@ -38,15 +37,48 @@ enum class SceneKind {
   kPyramid,  // drift of the top box: distance from its start (it should not move)
   kBounce,   // first apex of the sphere against e^2 h
   kIncline,  // distance slid along the slope against 1/2 g (sin - mu cos) t^2
-  kTerrain,  // time until every body is at rest, and bodies that fell through
+  kChain,    // largest joint anchor separation over the run (it should be ~0)
+  kArmPush,  // boxes the arm pushed, and how far its driven joint turned
 };
 
-// The hills of the terrain scenes: z = amplitude sin(x / wavelength)
-// cos(y / wavelength), m.
-struct Hills {
-  double amplitude = 0.0;
-  double wavelength = 1.0;
-  double HeightAt(double x, double y) const;
+// A link of an articulation: a rigid body in its link frame, which the
+// joint from its parent moves; inertia diagonal in the link frame.
+struct BenchLink {
+  double mass = 1.0;                     // kg
+  Vec3 center_of_mass = Vec3::Zero();    // m, link frame
+  Vec3 inertia_diagonal = Vec3::Ones();  // kg m^2, about the centre of mass
+  // A box collision shape centred on the centre of mass, its axes along the
+  // link frame's.
+  bool has_box = false;
+  Vec3 box_size = Vec3::Ones();  // m, full edge lengths
+  BenchMaterial material;
+};
+
+// A revolute joint: the child link frame is the parent link frame moved by
+// `parent_offset` and turned by the joint angle about `axis` (both in the
+// parent frame; the frames agree at angle 0).
+struct BenchJoint {
+  int parent = 0;                     // index into BenchArticulation::links, below the child's
+  Vec3 parent_offset = Vec3::Zero();  // m
+  Vec3 axis = Vec3::UnitY();          // unit
+  double position = 0.0;              // rad, initial
+  double effort_limit = 1e9;          // N m, the motor's
+};
+
+// One piecewise-constant velocity command for a joint's motor.
+struct MotorPhase {
+  double from_seconds = 0.0;  // s of simulated time
+  double velocity = 0.0;      // rad/s
+};
+
+// A fixed-base tree of revolute joints; joint j moves links[j + 1]. The
+// base has no collision shape.
+struct BenchArticulation {
+  Pose world_from_base;
+  std::vector<BenchLink> links;  // links[0] is the base, fixed to the world
+  std::vector<BenchJoint> joints;
+  // Velocity motors, per joint: none (limp) or phases in time order.
+  std::vector<std::vector<MotorPhase>> motors;
 };
 
 struct Scene {
@@ -61,10 +93,9 @@ struct Scene {
   int top_body = -1;           // index of the body whose drift is reported
   double drop_height = 0.0;    // m, bounce: fall of the sphere's lowest point
   double slope_degrees = 0.0;  // incline: slope angle
-  // When it has triangles, the ground is this static mesh (world frame)
-  // instead of the half-space, sampling `hills`.
-  physics::TriangleMesh terrain;
-  Hills hills;
+  // Articulated scenes: one articulation beside the free bodies.
+  std::vector<BenchArticulation> articulations;
+  int driven_joint = -1;  // arm: the joint whose swept angle is reported
 };
 
 // pile_N: unit boxes (1 m, 1 kg, mu 0.5, e 0) in a square grid of
@@ -80,13 +111,14 @@ Scene MakePyramid(int rows, double seconds);
 Scene MakeBounce();
 // incline: a unit box (1 kg, mu 0.5) at rest on a slope of `degrees`, for 2 s.
 Scene MakeIncline(double degrees);
-// terrain_N: N unit boxes (1 kg, mu 0.5) dropped from 1 m above rolling
-// hills (amplitude 0.5 m, wavelength 3 m) made of `triangles` (rounded up
-// to a square grid) over 40 x 40 m, in a square grid 3 m apart, each yawed
-// 0.3 rad more than the last. terrain_flat_N: the same drop onto the flat
-// half-space, the reference for the terrain's cost.
-Scene MakeTerrain(int count, int triangles, double seconds);
-Scene MakeFlatTerrain(int count, double seconds);
+// chain_30: 30 links of 0.1 m and 0.1 kg (point masses at their ends) and a
+// 100 kg tip, hinged about y, released horizontal from a fixed base 3.5 m up,
+// swinging for 10 s, with no collision shapes.
+Scene MakeChain(int links, double seconds);
+// arm_push_100: a fixed-base arm (yaw, shoulder and elbow, box links) whose
+// yaw motor sweeps it through 100 boxes of 0.1 m on the ground and back
+// (scene.cc); shoulder and elbow motors hold them still.
+Scene MakeArmPush(int boxes, double seconds);
 
 }  // namespace rigid_body_sim::bench
 

@@ -10,6 +10,7 @@ response in this client), appends the rows to the CSV and stops everything
 it started.
 """
 import argparse
+import csv
 import os
 import signal
 import socket
@@ -26,6 +27,18 @@ def free_port():
     with socket.socket() as probe:
         probe.bind(('localhost', 0))
         return probe.getsockname()[1]
+
+
+def append_rows(csv_path, rows, calls):
+    """Appends one row per model under the columns physics_bench wrote."""
+    with open(csv_path, newline='') as source:
+        columns = next(csv.reader(source))
+    with open(csv_path, 'a', newline='') as out:
+        writer = csv.DictWriter(out, fieldnames=columns, restval='')
+        for scene, median, low, high in rows:
+            writer.writerow({'scene': scene, 'engine': 'ours', 'threads': 1, 'bodies': 1,
+                             'steps': calls, 'ms_per_step_median': median,
+                             'ms_per_step_min': low, 'ms_per_step_max': high})
 
 
 def main():
@@ -85,9 +98,7 @@ def main():
                   f'{max(times):8.2f}')
             rows.append((scene, median, min(times), max(times)))
         if args.csv:
-            with open(args.csv, 'a') as out:
-                for scene, median, low, high in rows:
-                    out.write(f'{scene},ours,1,,{args.calls},{median},{low},{high}' + ',' * 16 + '\n')
+            append_rows(args.csv, rows, args.calls)
     finally:
         os.killpg(launch.pid, signal.SIGINT)
         try:

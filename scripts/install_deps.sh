@@ -8,13 +8,14 @@ packages=(
   catkin ros-core-dev libroscpp-dev libroslib-dev ros-message-generation ros-message-runtime
   libtf2-ros-dev liburdfdom-dev liburdf-dev libdiagnostic-updater-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev libvisualization-msgs-dev
+  libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev libvisualization-msgs-dev libsensor-msgs-dev
   libassimp-dev libqhull-dev libeigen3-dev
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
   libbullet-dev libbenchmark-dev python3-matplotlib
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
   python3-geometry-msgs python3-std-msgs python3-std-srvs python3-visualization-msgs
-  python3-rosgraph-msgs python3-tf2-msgs python3-diagnostic-msgs
+  python3-rosgraph-msgs python3-tf2-msgs python3-diagnostic-msgs python3-sensor-msgs
+  python3-trajectory-msgs libtrajectory-msgs-dev python3-tf2-ros
   clang libclang-rt-14-dev
 )
 

@@ -207,11 +207,20 @@ class ModelBuilder {
     loaded.name = model.getName();
     urdf::LinkConstSharedPtr body_root = model.getRoot();
     if (body_root->name == kWorldLink) {
-      loaded.is_static = true;
       if (body_root->child_links.size() != 1) {
         return Result<LoadedModel>::Error("link 'world' must have exactly one child link, has " +
                                           std::to_string(body_root->child_links.size()));
       }
+      // A fixed joint to the world makes the model static; a floating one
+      // leaves its root free.
+      const int world_type = body_root->child_links.front()->parent_joint->type;
+      if (world_type != urdf::Joint::FIXED && world_type != urdf::Joint::FLOATING) {
+        return Result<LoadedModel>::Error("joint '" +
+                                          body_root->child_links.front()->parent_joint->name +
+                                          "' to link 'world' is " + JointTypeName(world_type) +
+                                          "; a joint to 'world' must be fixed or floating");
+      }
+      loaded.is_static = world_type == urdf::Joint::FIXED;
       if (!body_root->collision_array.empty() || body_root->inertial != nullptr) {
         loaded.warnings.push_back(
             "link 'world' stands for the fixed world; its <collision> and <inertial> are ignored");
@@ -246,15 +255,30 @@ class ModelBuilder {
   Status CheckJoints(const urdf::ModelInterface& model) const {
     for (const auto& [name, joint] : model.joints_) {
       if (joint->type == urdf::Joint::FIXED) continue;
-      if (!options_.weld_movable_joints || !IsWeldable(joint->type)) {
-        return Status::Error(
-            "joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
-            "; only fixed joints are supported, movable joints are not simulated yet");
+      if (joint->type == urdf::Joint::FLOATING && joint->parent_link_name == kWorldLink) continue;
+      if (!IsWeldable(joint->type)) {
+        return Status::Error("joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
+                             "; supported joints are fixed, revolute, continuous and prismatic" +
+                             " (a model without a joint to 'world' has a floating base)");
+      }
+      if (!options_.articulate && !options_.weld_movable_joints) {
+        return Status::Error("joint " + Quoted(name) + " is " + JointTypeName(joint->type) +
+                             "; this load takes fixed joints only");
+      }
+      if (joint->mimic != nullptr) {
+        const auto leader = model.joints_.find(joint->mimic->joint_name);
+        if (leader == model.joints_.end() || !IsWeldable(leader->second->type) ||
+            leader->second->mimic != nullptr) {
+          return Status::Error("joint " + Quoted(name) + " mimics " +
+                               Quoted(joint->mimic->joint_name) +
+                               ", which is not a movable joint that mimics none");
+        }
       }
     }
     for (const auto& [name, position] : options_.joint_positions) {
       const auto found = model.joints_.find(name);
-      if (found == model.joints_.end() || !IsWeldable(found->second->type)) {
+      if (found == model.joints_.end() || !IsWeldable(found->second->type) ||
+          found->second->mimic != nullptr) {
         std::string movable;
         for (const auto& [other, joint] : model.joints_) {
           if (IsWeldable(joint->type)) movable += (movable.empty() ? "" : ", ") + Quoted(other);
@@ -277,6 +301,16 @@ class ModelBuilder {
     return Status::Ok();
   }
 
+  // The position given for a joint, 0 if none; a mimic joint's follows its
+  // leader's.
+  double InitialPosition(const urdf::Joint& joint) const {
+    const std::string& name = joint.mimic != nullptr ? joint.mimic->joint_name : joint.name;
+    const auto given = options_.joint_positions.find(name);
+    const double leader = given == options_.joint_positions.end() ? 0.0 : given->second;
+    if (joint.mimic == nullptr) return leader;
+    return joint.mimic->multiplier * leader + joint.mimic->offset;
+  }
+
   static bool IsWeldable(int type) {
     return type == urdf::Joint::REVOLUTE || type == urdf::Joint::CONTINUOUS ||
            type == urdf::Joint::PRISMATIC;
@@ -285,16 +319,39 @@ class ModelBuilder {
   // The child frame of a welded joint in its joint frame: a turn about the
   // axis, or a slide along it.
   Pose JointMotion(const urdf::Joint& joint, JointInfo* info, LoadedModel* loaded) const {
+    info->parent_from_joint = ToPose(joint.parent_to_joint_origin_transform);
     if (joint.type == urdf::Joint::FIXED) return Pose::Identity();
-    const auto given = options_.joint_positions.find(joint.name);
-    const double position = given == options_.joint_positions.end() ? 0.0 : given->second;
+    loaded->articulated = options_.articulate;
+    const double position = InitialPosition(joint);
     info->position = position;
-    loaded->warnings.push_back("joint " + Quoted(joint.name) + " is " + JointTypeName(joint.type) +
-                               "; welded at " + FormatNumber(position) +
-                               " (movable joints are not simulated yet)");
+    if (!options_.articulate) {
+      loaded->warnings.push_back("joint " + Quoted(joint.name) + " is " +
+                                 JointTypeName(joint.type) + "; welded at " +
+                                 FormatNumber(position));
+    }
     Vec3 axis(joint.axis.x, joint.axis.y, joint.axis.z);
     if (!(axis.norm() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();  // URDF's default axis
     axis.normalize();
+    info->axis = axis;
+    if (joint.limits != nullptr) {
+      if (joint.type != urdf::Joint::CONTINUOUS) {
+        info->lower = joint.limits->lower;
+        info->upper = joint.limits->upper;
+      }
+      // URDF's 0 means "not given" for effort and velocity in many
+      // descriptions; it is taken as no limit rather than a locked joint.
+      if (joint.limits->effort > 0.0) info->effort = joint.limits->effort;
+      if (joint.limits->velocity > 0.0) info->velocity = joint.limits->velocity;
+    }
+    if (joint.dynamics != nullptr) {
+      info->damping = joint.dynamics->damping;
+      info->friction = joint.dynamics->friction;
+    }
+    if (joint.mimic != nullptr) {
+      info->mimic_joint = joint.mimic->joint_name;
+      info->mimic_multiplier = joint.mimic->multiplier;
+      info->mimic_offset = joint.mimic->offset;
+    }
     if (joint.type == urdf::Joint::PRISMATIC) return Pose{axis * position, Quat::Identity()};
     return Pose{Vec3::Zero(), Quat(Eigen::AngleAxisd(position, axis))};
   }
@@ -329,7 +386,11 @@ class ModelBuilder {
         if (child == nullptr) {
           return Status::Error("joint " + Quoted((*joint)->name) + " has no child link");
         }
-        JointInfo info{(*joint)->name, JointTypeName((*joint)->type), link.name, child->name, 0.0};
+        JointInfo info;
+        info.name = (*joint)->name;
+        info.type = JointTypeName((*joint)->type);
+        info.parent_link = link.name;
+        info.child_link = child->name;
         const Pose root_from_child = next.root_from_link *
                                      ToPose((*joint)->parent_to_joint_origin_transform) *
                                      JointMotion(**joint, &info, loaded);
@@ -343,7 +404,7 @@ class ModelBuilder {
   Status AddLink(const urdf::Link& link, const Pose& root_from_link, LoadedModel* loaded,
                  std::vector<MassProperties>* parts_in_root) {
     const std::size_t link_index = loaded->links.size();
-    loaded->links.push_back(LinkFrame{link.name, root_from_link, 0.0});
+    loaded->links.push_back(LinkFrame{link.name, root_from_link, 0.0, MassProperties{}});
     const auto friction = friction_.find(link.name);
 
     std::vector<MassProperties> geometry_parts_in_link;
@@ -374,12 +435,14 @@ class ModelBuilder {
       Result<MassProperties> inertial = InertialMassProperties(link);
       if (!inertial.ok()) return inertial.status();
       loaded->links[link_index].mass = inertial->mass;
+      loaded->links[link_index].mass_in_link = *inertial;
       parts_in_root->push_back(physics::TransformMassProperties(*inertial, root_from_link));
     } else if (!geometry_parts_in_link.empty()) {
       // Overlapping collision elements count twice; a URDF that needs exact
       // mass properties for overlapping geometry states its <inertial>.
       const MassProperties from_geometry = physics::CombineMassProperties(geometry_parts_in_link);
       loaded->links[link_index].mass = from_geometry.mass;
+      loaded->links[link_index].mass_in_link = from_geometry;
       parts_in_root->push_back(physics::TransformMassProperties(from_geometry, root_from_link));
       if (!loaded->is_static) {
         loaded->warnings.push_back("link " + Quoted(link.name) +

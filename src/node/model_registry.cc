@@ -73,6 +73,28 @@ Result<BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
   return def;
 }
 
+Result<physics::ArticulationDef> MakeArticulationSpec(const io::LoadedModel& model,
+                                                      const ModelSpec& spec,
+                                                      const MaterialDefaults& defaults,
+                                                      std::vector<std::string>* warnings) {
+  // The materials as a rigid body of the same model would have them.
+  Result<BodyDef> rigid = MakeBodyDef(model, spec, defaults);
+  if (!rigid.ok()) return rigid.status();
+  io::LoadedModel with_materials = model;
+  for (std::size_t i = 0; i < model.shapes.size(); ++i) {
+    with_materials.shapes[i].shape.material = rigid->shapes[i].material;
+  }
+  Result<physics::ArticulationDef> made = io::MakeArticulationDef(with_materials, warnings);
+  if (!made.ok()) return made;
+  physics::ArticulationDef def = std::move(made).value();
+  def.fixed_base = spec.is_static || model.is_static;
+  def.world_from_base = spec.root_state.world_from_frame;
+  def.base_linear_velocity = def.fixed_base ? Vec3::Zero() : spec.root_state.linear_velocity;
+  def.base_angular_velocity = def.fixed_base ? Vec3::Zero() : spec.root_state.angular_velocity;
+  def.self_collide = spec.self_collide;
+  return def;
+}
+
 FrameState LinkStateFromRoot(const FrameState& root, const Pose& root_from_link) {
   FrameState link;
   link.world_from_frame = root.world_from_frame * root_from_link;
@@ -100,7 +122,8 @@ Status ModelRegistry::Add(Model model) {
   if (models_.count(model.name) != 0) {
     return Status::Error("a model named '" + model.name + "' already exists");
   }
-  name_by_body_[Key(model.body)] = model.name;
+  if (model.bodies.empty()) model.bodies = {model.body};
+  for (const physics::BodyId body : model.bodies) name_by_body_[Key(body)] = model.name;
   std::string name = model.name;
   models_.emplace(std::move(name), std::move(model));
   return Status::Ok();
@@ -109,7 +132,7 @@ Status ModelRegistry::Add(Model model) {
 bool ModelRegistry::Remove(const std::string& name) {
   const auto it = models_.find(name);
   if (it == models_.end()) return false;
-  name_by_body_.erase(Key(it->second.body));
+  for (const physics::BodyId body : it->second.bodies) name_by_body_.erase(Key(body));
   models_.erase(it);
   return true;
 }
@@ -142,8 +165,13 @@ Result<FrameRef> ModelRegistry::ResolveFrame(const std::string& frame) const {
 std::string ModelRegistry::ShapeFrame(physics::BodyId body, int shape_index) const {
   const Model* model = FindByBody(body);
   if (model == nullptr) return "";
-  assert(shape_index >= 0 && shape_index < static_cast<int>(model->shape_links.size()));
-  return FrameName(model->name, model->shape_links[shape_index]);
+  for (std::size_t k = 0; k < model->bodies.size() && k < model->body_shape_links.size(); ++k) {
+    if (model->bodies[k] != body) continue;
+    const std::vector<std::string>& links = model->body_shape_links[k];
+    assert(shape_index >= 0 && shape_index < static_cast<int>(links.size()));
+    return FrameName(model->name, links[shape_index]);
+  }
+  return "";
 }
 
 void ModelRegistry::Clear() {

@@ -111,6 +111,7 @@ Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request
   spec.is_static = request.is_static;
   spec.friction = request.friction;
   spec.restitution = request.restitution;
+  spec.self_collide = request.self_collide;
   if (request.joint_positions.size() != request.joint_names.size()) {
     return Result<ModelSpec>::Error(
         "joint_positions has " + std::to_string(request.joint_positions.size()) + " values for " +

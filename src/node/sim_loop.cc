@@ -33,6 +33,7 @@ void SimNode::StepLocked() {
   wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(),
                                  [](const ActiveWrench& w) { return w.remaining_steps <= 0; }),
                   wrenches_.end());
+  FollowTrajectoriesLocked();
   const Clock::time_point start = Clock::now();
   world_.Step();
   diagnostics_->RecordStep(std::chrono::duration<double>(Clock::now() - start).count(),

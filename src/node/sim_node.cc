@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <exception>
 #include <filesystem>
+#include <map>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -62,9 +64,8 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
     return io::CachedMeshTriangles(path, scale, mesh_limits);
   };
   load_options_.resolver = ResolveRosUri;
-  // A robot_description with movable joints spawns as one rigid body until
-  // joints are simulated; its joints keep their initial positions.
-  load_options_.weld_movable_joints = true;
+  // Movable joints are simulated: a model with any becomes an articulation.
+  load_options_.articulate = true;
 }
 
 SimNode::~SimNode() {
@@ -193,6 +194,7 @@ void SimNode::AdvertiseServices() {
   services_.push_back(Advertise(names::kCancelStepService, &Self::OnCancelStep));
   services_.push_back(Advertise(names::kGetStateService, &Self::OnGetState));
   services_.push_back(Advertise(names::kSetStateService, &Self::OnSetState));
+  services_.push_back(Advertise(names::kSetJointStateService, &Self::OnSetJointState));
   services_.push_back(Advertise(names::kApplyWrenchService, &Self::OnApplyWrench));
   services_.push_back(Advertise(names::kGetPhysicsService, &Self::OnGetPhysics));
   services_.push_back(Advertise(names::kSetPhysicsService, &Self::OnSetPhysics));
@@ -226,8 +228,16 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
   }
   Result<io::LoadedModel> loaded = LoadModel(spec);
   if (!loaded.ok()) return loaded.status();
+  std::vector<std::string> warnings = loaded->warnings;
   Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, defaults);
   if (!def.ok()) return def.status();
+  std::optional<physics::ArticulationDef> articulation;
+  if (loaded->articulated) {
+    Result<physics::ArticulationDef> made =
+        MakeArticulationSpec(*loaded, spec, defaults, &warnings);
+    if (!made.ok()) return made.status();
+    articulation = std::move(made).value();
+  }
 
   Outbox outbox;
   std::vector<std::string> frames;
@@ -236,44 +246,111 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     if (registry_.Find(spec.name) != nullptr) {
       return FramesResult::Error("a model named '" + spec.name + "' already exists");
     }
-    Result<BodyId> body = world_.CreateBody(*def);
-    if (!body.ok()) return body.status();
     Model model;
     model.name = spec.name;
-    model.body = *body;
-    model.is_static = def->is_static;
+    const Status created = articulation ? CreateArticulationLocked(*articulation, *loaded, &model)
+                                        : CreateBodyLocked(*def, *loaded, &model);
+    if (!created.ok()) return created;
     model.links = loaded->links;
     model.joints = loaded->joints;
     model.mass = def->is_static ? 0.0 : def->mass_properties.mass;
-    for (const io::LoadedShape& shape : loaded->shapes)
-      model.shape_links.push_back(shape.link_name);
     model.spawn_state =
         FrameState{def->world_from_body, def->linear_velocity, def->angular_velocity};
     for (const io::LinkFrame& link : model.links) {
       frames.push_back(FrameName(spec.name, link.link_name));
     }
-    std::vector<visualization_msgs::Marker> markers =
-        ShapeMarkers(def->shapes, spec.name, FrameName(spec.name, loaded->root_link));
+    std::vector<visualization_msgs::Marker> markers;
+    if (articulation) {
+      // One marker per shape, in its articulation link's frame; ids run on
+      // across the links so that none replaces another.
+      for (const physics::LinkDef& link : articulation->links) {
+        for (visualization_msgs::Marker& marker :
+             ShapeMarkers(link.shapes, spec.name, FrameName(spec.name, link.name))) {
+          marker.id = static_cast<int>(markers.size());
+          markers.push_back(std::move(marker));
+        }
+      }
+    } else {
+      markers = ShapeMarkers(def->shapes, spec.name, FrameName(spec.name, loaded->root_link));
+    }
     outbox.body_markers.emplace().markers = markers;
     body_markers_[spec.name] = std::move(markers);
     const Status added = registry_.Add(std::move(model));
     assert(added.ok());
     const Model& stored = *registry_.Find(spec.name);
-    if (stored.is_static) {
-      outbox.tf_static = StaticTfLocked();
-    } else {
+    if (stored.is_static || stored.articulation.IsValid()) outbox.tf_static = StaticTfLocked();
+    if (!stored.is_static) {
       outbox.tf = ModelTfLocked(stored);
       outbox.tf_is_new_frame = true;
       outbox.reset_count = reset_count_;
     }
   }
   Publish(std::move(outbox));
-  for (const std::string& warning : loaded->warnings) {
+  for (const std::string& warning : warnings) {
     ROS_WARN("model '%s': %s", spec.name.c_str(), warning.c_str());
   }
   ROS_INFO("spawned '%s' (%s, %zu shapes, %zu frames)", spec.name.c_str(),
-           def->is_static ? "static" : "dynamic", def->shapes.size(), frames.size());
+           articulation ? (articulation->fixed_base ? "articulated, fixed base"
+                                                    : "articulated, floating base")
+                        : (def->is_static ? "static" : "dynamic"),
+           def->shapes.size(), frames.size());
   return frames;
+}
+
+// A rigid model: one body, every link a frame of it.
+Status SimNode::CreateBodyLocked(const physics::BodyDef& def, const io::LoadedModel& loaded,
+                                 Model* model) {
+  Result<BodyId> body = world_.CreateBody(def);
+  if (!body.ok()) return body.status();
+  model->body = *body;
+  model->bodies = {*body};
+  model->is_static = def.is_static;
+  model->body_shape_links.emplace_back();
+  for (const io::LoadedShape& shape : loaded.shapes) {
+    model->body_shape_links.back().push_back(shape.link_name);
+  }
+  for (const io::LinkFrame& link : loaded.links) {
+    model->link_body.push_back(0);
+    model->body_from_link.push_back(link.root_from_link);
+  }
+  return Status::Ok();
+}
+
+// An articulated model: one body per articulation link (a group of URDF
+// links joined by fixed joints); each URDF link is a frame of its group's
+// body. Its links move even when its base is fixed, so it is never static.
+Status SimNode::CreateArticulationLocked(const physics::ArticulationDef& def,
+                                         const io::LoadedModel& loaded, Model* model) {
+  Result<physics::ArticulationId> id = world_.CreateArticulation(def);
+  if (!id.ok()) return id.status();
+  model->articulation = *id;
+  model->bodies = world_.ArticulationLinks(*id);
+  model->body = model->bodies.front();
+  model->is_static = false;
+  std::map<std::string, int> group_of_link;
+  for (std::size_t g = 0; g < def.links.size(); ++g) group_of_link[def.links[g].name] = g;
+  for (const io::JointInfo& joint : loaded.joints) {
+    if (joint.type == "fixed") {
+      group_of_link[joint.child_link] = group_of_link.at(joint.parent_link);
+    } else {
+      model->joint_names.push_back(joint.name);
+      model->spawn_joint_positions.push_back(joint.position);
+    }
+  }
+  model->body_shape_links.resize(def.links.size());
+  for (const io::LoadedShape& shape : loaded.shapes) {
+    model->body_shape_links[group_of_link.at(shape.link_name)].push_back(shape.link_name);
+  }
+  std::map<std::string, const io::LinkFrame*> frame_of_link;
+  for (const io::LinkFrame& link : loaded.links) frame_of_link[link.link_name] = &link;
+  for (const io::LinkFrame& link : loaded.links) {
+    const int group = group_of_link.at(link.link_name);
+    model->link_body.push_back(group);
+    model->body_from_link.push_back(
+        frame_of_link.at(def.links[group].name)->root_from_link.Inverse() * link.root_from_link);
+  }
+  AdvertiseJointTopicsLocked(*model);
+  return Status::Ok();
 }
 
 }  // namespace rigid_body_sim::node

@@ -77,13 +77,17 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
     if (model == nullptr) {
       return Fail(response, "no model named '" + request.name + "'", names::kDeleteService);
     }
-    const BodyId body = model->body;
-    const bool was_static = model->is_static;
-    const Status destroyed = world_.DestroyBody(body);
+    const std::vector<BodyId> bodies = model->bodies;
+    const bool was_static = model->is_static || model->articulation.IsValid();
+    const Status destroyed = model->articulation.IsValid()
+                                 ? world_.DestroyArticulation(model->articulation)
+                                 : world_.DestroyBody(model->body);
     assert(destroyed.ok());
-    wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(),
-                                   [body](const ActiveWrench& w) { return w.body == body; }),
-                    wrenches_.end());
+    const auto on_model = [&bodies](const ActiveWrench& w) {
+      return std::find(bodies.begin(), bodies.end(), w.body) != bodies.end();
+    };
+    wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(), on_model), wrenches_.end());
+    if (model->articulation.IsValid()) RemoveJointTopics(request.name);
     registry_.Remove(request.name);
     frozen_models_.erase(request.name);
     const int marker_count = static_cast<int>(body_markers_[request.name].size());
@@ -200,8 +204,8 @@ bool SimNode::OnGetState(rigid_body_sim::GetState::Request& request,
   std::unique_lock<std::mutex> lock = LockWorld();
   Result<FrameRef> frame = registry_.ResolveFrame(request.name);
   if (!frame.ok()) return Fail(response, frame.message(), names::kGetStateService);
-  const FrameState state =
-      LinkStateFromRoot(RootStateLocked(*frame->model), frame->link->root_from_link);
+  const FrameState state = LinkStateLocked(
+      *frame->model, static_cast<std::size_t>(frame->link - frame->model->links.data()));
   response.success = true;
   if (frozen_models_.count(frame->model->name) != 0) {
     response.message =
@@ -225,13 +229,18 @@ bool SimNode::OnSetState(rigid_body_sim::SetState::Request& request,
     std::unique_lock<std::mutex> lock = LockWorld();
     Result<FrameRef> frame = registry_.ResolveFrame(request.name);
     if (!frame.ok()) return Fail(response, frame.message(), names::kSetStateService);
-    FrameState root = RootStateFromLink(*link_state, frame->link->root_from_link);
-    if (frame->model->is_static) {
+    // The body that carries the link takes the state that puts the link
+    // where asked; an articulated model moves rigidly with it.
+    const Model& model = *frame->model;
+    const std::size_t link = static_cast<std::size_t>(frame->link - model.links.data());
+    FrameState root = RootStateFromLink(*link_state, model.body_from_link[link]);
+    if (model.is_static) {
       root.linear_velocity.setZero();
       root.angular_velocity.setZero();
     }
-    const Status status = world_.SetState(frame->model->body, root.world_from_frame,
-                                          root.linear_velocity, root.angular_velocity);
+    const Status status =
+        world_.SetState(model.bodies[model.link_body[link]], root.world_from_frame,
+                        root.linear_velocity, root.angular_velocity);
     if (!status.ok()) return Fail(response, status.message(), names::kSetStateService);
     frozen_models_.erase(frame->model->name);
     if (frame->model->is_static) outbox.tf_static = StaticTfLocked();
@@ -264,7 +273,9 @@ bool SimNode::OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,
   // The wrench acts for the steps that cover `duration` at the current time
   // step, at least one.
   const std::int64_t steps = WrenchSteps(request.duration, world_.settings().time_step);
-  wrenches_.push_back(ActiveWrench{frame->model->body, *force, *point, *torque, steps});
+  const std::size_t link = static_cast<std::size_t>(frame->link - frame->model->links.data());
+  const BodyId body = frame->model->bodies[frame->model->link_body[link]];
+  wrenches_.push_back(ActiveWrench{body, *force, *point, *torque, steps});
   response.success = true;
   response.message = "wrench on '" + request.name + "' for " + std::to_string(steps) + " steps";
   return true;

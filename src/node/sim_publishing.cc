@@ -1,5 +1,6 @@
 // What the node publishes: tf, model states, contacts and their markers, and
 // /clock, built under the world lock and sent after it is released.
+#include <cassert>
 #include <string>
 #include <vector>
 
@@ -13,47 +14,87 @@ namespace rigid_body_sim::node {
 
 using physics::BodyId;
 
-FrameState SimNode::RootStateLocked(const Model& model) const {
-  return FrameState{world_.GetPose(model.body), world_.GetLinearVelocity(model.body),
-                    world_.GetAngularVelocity(model.body)};
+FrameState SimNode::LinkStateLocked(const Model& model, std::size_t link) const {
+  const BodyId body = model.bodies[model.link_body[link]];
+  const FrameState body_state{world_.GetPose(body), world_.GetLinearVelocity(body),
+                              world_.GetAngularVelocity(body)};
+  return LinkStateFromRoot(body_state, model.body_from_link[link]);
 }
 
 ros::Time SimNode::StampLocked() const {
   return options_.use_sim_time ? SimTimeToRos(world_.time()) : ros::Time::now();
 }
 
+namespace {
+
+std::size_t LinkIndex(const Model& model, const std::string& link_name) {
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    if (model.links[i].link_name == link_name) return i;
+  }
+  assert(false && "a joint names a link of its model");
+  return 0;
+}
+
+}  // namespace
+
+// A rigid model: every link frame from the world frame. An articulated one
+// follows the URDF tree: the world to its root link, then each movable
+// joint's parent link to its child link (its fixed joints are static).
+void SimNode::AppendModelTfLocked(const Model& model, const ros::Time& stamp,
+                                  tf2_msgs::TFMessage* tf) const {
+  if (!model.articulation.IsValid()) {
+    for (std::size_t i = 0; i < model.links.size(); ++i) {
+      tf->transforms.push_back(
+          TransformToMsg(LinkStateLocked(model, i).world_from_frame, options_.world_frame,
+                         FrameName(model.name, model.links[i].link_name), stamp));
+    }
+    return;
+  }
+  tf->transforms.push_back(TransformToMsg(LinkStateLocked(model, 0).world_from_frame,
+                                          options_.world_frame,
+                                          FrameName(model.name, model.links[0].link_name), stamp));
+  for (const io::JointInfo& joint : model.joints) {
+    if (joint.type == "fixed") continue;
+    const physics::Pose world_from_parent =
+        LinkStateLocked(model, LinkIndex(model, joint.parent_link)).world_from_frame;
+    const physics::Pose world_from_child =
+        LinkStateLocked(model, LinkIndex(model, joint.child_link)).world_from_frame;
+    tf->transforms.push_back(TransformToMsg(world_from_parent.Inverse() * world_from_child,
+                                            FrameName(model.name, joint.parent_link),
+                                            FrameName(model.name, joint.child_link), stamp));
+  }
+}
+
 tf2_msgs::TFMessage SimNode::ModelTfLocked(const Model& model) const {
   tf2_msgs::TFMessage tf;
-  const FrameState root = RootStateLocked(model);
-  const ros::Time stamp = StampLocked();
-  for (const io::LinkFrame& link : model.links) {
-    tf.transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
-                                           options_.world_frame,
-                                           FrameName(model.name, link.link_name), stamp));
-  }
+  AppendModelTfLocked(model, StampLocked(), &tf);
   return tf;
 }
 
+// The frames of static models, and the fixed joints of articulated ones.
 tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
   tf2_msgs::TFMessage tf;
+  const ros::Time stamp = StampLocked();
   for (const auto& [name, model] : registry_.models()) {
-    if (!model.is_static) continue;
-    tf2_msgs::TFMessage model_tf = ModelTfLocked(model);
-    tf.transforms.insert(tf.transforms.end(), model_tf.transforms.begin(),
-                         model_tf.transforms.end());
+    if (model.is_static) AppendModelTfLocked(model, stamp, &tf);
+    if (!model.articulation.IsValid()) continue;
+    for (const io::JointInfo& joint : model.joints) {
+      if (joint.type != "fixed") continue;
+      const physics::Pose& root_from_parent =
+          model.links[LinkIndex(model, joint.parent_link)].root_from_link;
+      const physics::Pose& root_from_child =
+          model.links[LinkIndex(model, joint.child_link)].root_from_link;
+      tf.transforms.push_back(TransformToMsg(root_from_parent.Inverse() * root_from_child,
+                                             FrameName(name, joint.parent_link),
+                                             FrameName(name, joint.child_link), stamp));
+    }
   }
   return tf;
 }
 
 void SimNode::FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const {
   for (const auto& [name, model] : registry_.models()) {
-    if (model.is_static) continue;
-    const FrameState root = RootStateLocked(model);
-    for (const io::LinkFrame& link : model.links) {
-      tf->transforms.push_back(TransformToMsg(root.world_from_frame * link.root_from_link,
-                                              options_.world_frame, FrameName(name, link.link_name),
-                                              stamp));
-    }
+    if (!model.is_static) AppendModelTfLocked(model, stamp, tf);
   }
 }
 
@@ -67,15 +108,15 @@ void SimNode::FillPeriodicLocked(Outbox* outbox) {
   states.header.frame_id = options_.world_frame;
   states.name.reserve(registry_.size());
   for (const auto& [name, model] : registry_.models()) {
-    const FrameState root = RootStateLocked(model);
-    for (const io::LinkFrame& link : model.links) {
-      const FrameState state = LinkStateFromRoot(root, link.root_from_link);
-      states.name.push_back(FrameName(name, link.link_name));
+    for (std::size_t i = 0; i < model.links.size(); ++i) {
+      const FrameState state = LinkStateLocked(model, i);
+      states.name.push_back(FrameName(name, model.links[i].link_name));
       states.pose.push_back(PoseToMsg(state.world_from_frame));
       states.twist.push_back(TwistToMsg(state.linear_velocity, state.angular_velocity));
     }
   }
   states.frozen.assign(frozen_models_.begin(), frozen_models_.end());
+  FillJointStatesLocked(stamp, outbox);
   // tf2 drops a transform whose stamp it already holds, so under sim time
   // tf goes out only when sim time moved; contacts always only then.
   const bool sim_time_moved = sim_time != last_periodic_time_;
@@ -135,6 +176,7 @@ void SimNode::Publish(Outbox outbox) {
     }
   }
   if (outbox.states) states_publisher_.publish(*outbox.states);
+  PublishJointStates(outbox);
   if (outbox.contacts) contacts_publisher_.publish(*outbox.contacts);
   if (outbox.contact_markers && !outbox.contact_markers->markers.empty()) {
     contact_markers_publisher_.publish(*outbox.contact_markers);

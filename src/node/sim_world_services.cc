@@ -17,11 +17,13 @@ std::string SimNode::Reset(bool keep_time) {
     std::unique_lock<std::mutex> lock = LockWorld();
     for (const auto& [name, model] : registry_.models()) {
       const FrameState& state = model.spawn_state;
-      const Status status = world_.SetState(model.body, state.world_from_frame,
-                                            state.linear_velocity, state.angular_velocity);
+      Status status = world_.SetState(model.body, state.world_from_frame, state.linear_velocity,
+                                      state.angular_velocity);
+      if (status.ok()) status = ResetJointsLocked(model);
       assert(status.ok());
     }
     wrenches_.clear();
+    trajectories_.clear();
     frozen_models_.clear();
     if (keep_time) {
       // SetState already dropped every body's contacts and woke it; sim time,

@@ -56,7 +56,8 @@ void WorldImpl::GuardBeforeStep(double dt) {
   guard_start_poses_.resize(bodies_.size());
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || body.disabled) continue;
+    // A link's state is its articulation's, which guards it as a whole.
+    if (!body.in_use || body.is_static || body.disabled || body.articulation >= 0) continue;
     const bool pose_is_finite = body.position.allFinite() && IsFinite(body.orientation);
     if (pose_is_finite) guard_start_poses_[i] = body.WorldFromPrincipal();
     if (!body.awake || StepIsSafe(body, dt)) continue;
@@ -69,7 +70,7 @@ void WorldImpl::GuardBeforeStep(double dt) {
 void WorldImpl::GuardAfterStep() {
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Body& body = bodies_[i];
-    if (!body.in_use || body.is_static) continue;
+    if (!body.in_use || body.is_static || body.articulation >= 0) continue;
     // A body the stages disabled for a state that is not finite still holds
     // that state; one frozen here before holds a finite one.
     if (body.disabled ? body.HasFiniteState() : StateIsSafe(body)) continue;

@@ -129,6 +129,8 @@ void WorldImpl::SubStep(const std::vector<std::uint32_t>& island, double h, int 
   for (ShapePairContact* pair : pairs) {
     RecollidePair(h, pair);
     if (pair->manifold.point_count == 0) continue;
+    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0)
+      continue;
     MatchWarmStarts(pair);
     touching.push_back(pair);
   }

@@ -117,6 +117,7 @@ ImpactBracket NarrowImpactBracket(const PairSweep& sweep, double target_gap, dou
 // wall it would pass through entirely still shows a penetrating sample to
 // bracket. Pairs that cannot close their gap within the step are skipped.
 void WorldImpl::IntegrateBodies(double dt) {
+  MoveArticulations(dt);
   DriftBodies(dt);
   BoundBodyMotion(dt);
   ResolveImpacts(dt, FindImpacts(dt, contact_cache_.seen()), contact_cache_.touching(), 0);
@@ -181,6 +182,10 @@ std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePai
     PrefetchAhead(pairs, e, PrefetchManifold);
     ShapePairContact* pair = pairs[e];
     if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) continue;
+    // A link's contacts are the articulation solve's, which lets no point
+    // close more than its gap within a step.
+    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0)
+      continue;
     double approach_speed = 0.0;
     const double time = PairImpactTime(dt, pair, &approach_speed);
     if (!std::isfinite(time)) continue;
@@ -365,6 +370,13 @@ void WorldImpl::UpdateSleep(double dt) {
     if (a.is_static || b.is_static) continue;
     islands.Join(pair->body_a, pair->body_b);
   }
+  // Articulations never sleep, nor does what touches them.
+  std::vector<char> island_has_link(bodies_.size(), 0);
+  for (const ShapePairContact* pair : link_pairs_) {
+    for (const std::uint32_t index : {pair->body_a, pair->body_b}) {
+      if (bodies_[index].articulation >= 0) island_has_link[islands.Find(index)] = 1;
+    }
+  }
   std::vector<double> island_sleep_time(bodies_.size(), std::numeric_limits<double>::infinity());
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
@@ -376,7 +388,7 @@ void WorldImpl::UpdateSleep(double dt) {
         body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
     body.sleep_time = slow ? body.sleep_time + dt : 0.0;
     double& island = island_sleep_time[islands.Find(i)];
-    island = std::min(island, body.sleep_time);
+    island = std::min(island, island_has_link[islands.Find(i)] ? 0.0 : body.sleep_time);
   }
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];

@@ -192,6 +192,7 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double
   MovingBodyFirst(bodies_, &body_a, &body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
+  if (SkipsPair(a, b)) return;
   const double contact_distance = ContactDistance(a, b, dt);
   const double travel = a.travel + b.travel;
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;

@@ -180,11 +180,17 @@ void WorldImpl::SolveContacts(double dt) {
   moving_bodies_.clear();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Body& body = bodies_[i];
-    if (body.in_use && !body.is_static && body.awake && !body.disabled) moving_bodies_.push_back(i);
+    if (body.in_use && !body.is_static && body.awake && !body.disabled && body.articulation < 0) {
+      moving_bodies_.push_back(i);
+    }
   }
-  const std::vector<ShapePairContact*>& pairs = contact_cache_.touching();
-  SolveTouching(dt, pairs);
-  ReportContacts(pairs, dt, /*impacts_only=*/false);
+  // The contact solver takes the pairs of rigid bodies; the articulations'
+  // solve, after it, the pairs with a link (step_articulations.cc).
+  SplitLinkPairs(contact_cache_.touching());
+  SolveTouching(dt, rigid_pairs_);
+  SolveArticulations(dt);
+  ReportContacts(rigid_pairs_, dt, /*impacts_only=*/false);
+  ReportLinkContacts(dt);
 }
 
 // The contact solve of the touching pairs over dt, for the bodies of

@@ -44,4 +44,26 @@ const std::vector<BodyId>& World::non_finite_bodies() const { return impl_->non_
 const std::vector<ContactReport>& World::contacts() const { return impl_->contacts(); }
 std::vector<ContactReport> World::TakeCollisionLog() { return impl_->TakeCollisionLog(); }
 
+Result<ArticulationId> World::CreateArticulation(const ArticulationDef& def) {
+  return impl_->CreateArticulation(def);
+}
+Status World::DestroyArticulation(ArticulationId id) { return impl_->DestroyArticulation(id); }
+bool World::IsValid(ArticulationId id) const { return impl_->IsValid(id); }
+std::vector<BodyId> World::ArticulationLinks(ArticulationId id) const {
+  return impl_->ArticulationLinks(id);
+}
+std::vector<JointState> World::GetJointStates(ArticulationId id) const {
+  return impl_->GetJointStates(id);
+}
+Status World::SetJointStates(ArticulationId id, const std::vector<double>& positions,
+                             const std::vector<double>& velocities) {
+  return impl_->SetJointStates(id, positions, velocities);
+}
+Status World::SetJointCommand(ArticulationId id, int joint, const JointCommand& command) {
+  return impl_->SetJointCommand(id, joint, command);
+}
+Status World::SetServoGains(ArticulationId id, const ServoGains& gains) {
+  return impl_->SetServoGains(id, gains);
+}
+
 }  // namespace rigid_body_sim::physics

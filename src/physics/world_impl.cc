@@ -26,6 +26,8 @@ std::string Describe(const Vec3& v) {
   return out.str();
 }
 
+}  // namespace
+
 Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
                      const Vec3& angular_velocity) {
   if (!IsFinite(world_from_body.translation)) {
@@ -79,8 +81,6 @@ void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
   body->start_linear_velocity = body->linear_velocity;
   body->start_angular_momentum = body->angular_momentum;
 }
-
-}  // namespace
 
 WorldImpl::WorldImpl(const WorldSettings& settings) : settings_(settings) {
   assert(ValidateWorldSettings(settings).ok());
@@ -177,6 +177,9 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
 Status WorldImpl::DestroyBody(BodyId id) {
   if (!IsValid(id)) return Status::Error("no body with this id");
   Body& body = bodies_[id.index];
+  if (body.articulation >= 0) {
+    return Status::Error("the body is a link of an articulation; destroy the articulation");
+  }
   if (body.has_proxy) broad_phase_.RemoveProxy(static_cast<int>(id.index));
   contact_cache_.RemoveBody(id.index);
   half_space_bodies_.erase(
@@ -223,6 +226,10 @@ Status WorldImpl::SetState(BodyId id, const Pose& world_from_body, const Vec3& l
     return status;
   }
   Body& body = MutableBody(id);
+  if (body.articulation >= 0) {
+    return MoveArticulation(static_cast<std::uint32_t>(body.articulation), world_from_body,
+                            linear_velocity, angular_velocity, body.link);
+  }
   body.disabled = false;
   SetBodyState(world_from_body, linear_velocity, angular_velocity, &body);
   // Teleported: last step's contacts and impulses no longer apply, and

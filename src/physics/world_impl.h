@@ -10,10 +10,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "physics/articulation_dynamics.h"
+#include "physics/articulation_solver.h"
 #include "physics/broad_phase.h"
 #include "physics/contact_cache.h"
 #include "physics/contact_solver.h"
 #include "physics/integrator.h"
+#include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/result.h"
@@ -27,6 +30,26 @@ struct Impact {
   ShapePairContact* pair = nullptr;
   double time = 0.0;       // s from the (sub)step's start
   bool colliding = false;  // the surfaces meet faster than collision_velocity_threshold
+};
+
+// Refuses a non-finite pose or velocity, or a quaternion not of unit length.
+Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
+                     const Vec3& angular_velocity);
+
+// Sets a body's state (x, q, P, L) from the pose of its body frame and the
+// twist of that frame's origin, and restarts its sleep and step records.
+void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
+                  const Vec3& angular_velocity, Body* body);
+
+// An articulation in the world: its model, its state, and the state its
+// constraint solve chose for the end of the step.
+struct ArticulationEntry {
+  ArticulationModel model;
+  ArticulationState state;
+  ArticulationState next;
+  ServoGains gains;
+  bool in_use = false;
+  std::uint32_t generation = 0;
 };
 
 // The public methods do what World's of the same name are documented to do.
@@ -58,8 +81,20 @@ class WorldImpl {
   const std::vector<ContactReport>& contacts() const { return contacts_; }
   std::vector<ContactReport> TakeCollisionLog();
 
+  // Articulations (world_articulations.cc).
+  Result<ArticulationId> CreateArticulation(const ArticulationDef& def);
+  Status DestroyArticulation(ArticulationId id);
+  bool IsValid(ArticulationId id) const;
+  std::vector<BodyId> ArticulationLinks(ArticulationId id) const;
+  std::vector<JointState> GetJointStates(ArticulationId id) const;
+  Status SetJointStates(ArticulationId id, const std::vector<double>& positions,
+                        const std::vector<double>& velocities);
+  Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command);
+  Status SetServoGains(ArticulationId id, const ServoGains& gains);
+
  private:
   Body& MutableBody(BodyId id);
+  BodyId BodyIdOf(std::uint32_t index) const;
   void Wake(std::uint32_t body);
   // Wakes every body that touched `body` in the last step.
   void WakeTouching(std::uint32_t body);
@@ -111,6 +146,21 @@ class WorldImpl {
   ContactReport MakeReport(const ShapePairContact& pair, int point,
                            const std::array<Vec3, 2>& tangent, double dt) const;
 
+  // Articulations (world_articulations.cc, step_articulations.cc).
+  Status MoveArticulation(std::uint32_t index, const Pose& world_from_link,
+                          const Vec3& linear_velocity, const Vec3& angular_velocity, int link);
+  void PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart);
+  bool SkipsPair(const Body& a, const Body& b) const;
+  // Splits the touching pairs into those of rigid bodies only (the contact
+  // solver's) and those with a link (the articulation solve's).
+  void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
+  void SolveArticulations(double dt);
+  void AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free, double dt);
+  void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
+                          const std::vector<ArticulationKinematics>& kinematics);
+  void ReportLinkContacts(double dt);
+  void MoveArticulations(double dt);
+
   WorldSettings settings_;
   std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
@@ -136,6 +186,12 @@ class WorldImpl {
   std::vector<BodyId> non_finite_bodies_;
   std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
   StepProfile last_step_profile_;
+  std::vector<ArticulationEntry> articulations_;
+  ArticulationSolver articulation_solver_;
+  std::vector<ShapePairContact*> rigid_pairs_;  // SplitLinkPairs'
+  std::vector<ShapePairContact*> link_pairs_;
+  // Per link pair, the index of its first normal row, or -1.
+  std::vector<int> link_pair_rows_;
 };
 
 }  // namespace rigid_body_sim::physics

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the built catkin workspace into a temporary prefix and runs the
 # package from there alone, in a clean environment: rospack finds it in the
-# prefix, `roslaunch rigid_body_sim demo.launch` brings up the demo's 17
+# prefix, `roslaunch rigid_body_sim demo.launch` brings up the demo's 19
 # models, and the installed spawn_model adds one more from a file given
 # relative to the caller's directory. Run by ctest (install_test) with the
 # workspace's build directory as its argument.
@@ -77,7 +77,7 @@ EOF
     }
     demo=$(models)
     count=$(wc -w <<< "$demo")
-    [ "$count" = 17 ] || { echo "[install_test] demo has $count models: $demo" >&2;
+    [ "$count" = 19 ] || { echo "[install_test] demo has $count models: $demo" >&2;
                            cat "$PREFIX/launch.log" >&2; exit 1; }
     cd "$CALLER"
     rosrun rigid_body_sim spawn_model -urdf -file models/box.urdf -model installed_box -z 3

@@ -256,22 +256,33 @@ TEST(UrdfLoaderTest, WorldJointMakesAStaticBodyAndInertialFramesAreHonoured) {
   EXPECT_LE((model->mass_properties.inertia_about_com - expected.inertia_about_com).norm(), 1e-9);
 }
 
-// Every URDF shipped in urdf/ loads, the six sample bodies among them.
+// Every URDF shipped in urdf/ loads as the node loads it (movable joints
+// simulated), the six sample bodies and the demo arm among them.
 TEST(UrdfLoaderTest, EveryShippedUrdfLoads) {
   std::set<std::string> loaded;
+  UrdfLoadOptions options = PackageOptions();
+  options.articulate = true;
   for (const auto& entry : std::filesystem::directory_iterator(RBS_URDF_DIR)) {
     if (entry.path().extension() != ".urdf") continue;
     SCOPED_TRACE(entry.path().string());
-    const Result<LoadedModel> model = LoadUrdfFile(entry.path().string(), PackageOptions());
+    const Result<LoadedModel> model = LoadUrdfFile(entry.path().string(), options);
     ASSERT_TRUE(model.ok()) << model.message();
     EXPECT_FALSE(model->shapes.empty());
+    if (model->articulated) {
+      std::vector<std::string> warnings;
+      const Result<physics::ArticulationDef> def = MakeArticulationDef(*model, &warnings);
+      ASSERT_TRUE(def.ok()) << def.message();
+      for (const physics::LinkDef& link : def->links) {
+        EXPECT_TRUE(physics::ValidateMassProperties(link.mass_properties).ok()) << link.name;
+      }
+    }
     if (!model->is_static) {
       EXPECT_TRUE(physics::ValidateMassProperties(model->mass_properties).ok());
     }
     loaded.insert(entry.path().filename().string());
   }
   for (const char* sample : {"box.urdf", "sphere.urdf", "cylinder.urdf", "mesh_object.urdf",
-                             "table.urdf", "compound.urdf"}) {
+                             "table.urdf", "compound.urdf", "demo_arm.urdf"}) {
     EXPECT_EQ(loaded.count(sample), 1u) << sample;
   }
 }
@@ -499,12 +510,82 @@ TEST(UrdfLoaderTest, BadJointPositionsAreRefusedByName) {
   ASSERT_FALSE(model.ok());
   EXPECT_EQ(model.message(),
             "joint 'wrist' is not a movable joint of the model; movable: 'elbow', 'slider'");
-  // Without welding, the same model is refused as before.
+  // Neither welded nor articulated, the same model is refused.
   options.weld_movable_joints = false;
   options.joint_positions.clear();
   model = LoadUrdfString(ArmUrdf(), options);
   ASSERT_FALSE(model.ok());
   EXPECT_NE(model.message().find("joint 'elbow' is revolute"), std::string::npos);
+}
+
+// Articulated: each movable joint a joint of the articulation, links with
+// their own masses, joint frames in the parent link's frame, limits, and
+// the initial positions; planar joints are refused by name.
+TEST(UrdfLoaderTest, ArticulatedModelKeepsItsJoints) {
+  UrdfLoadOptions options;
+  options.articulate = true;
+  options.joint_positions = {{"elbow", 0.5}};
+  const Result<LoadedModel> model = LoadUrdfString(ArmUrdf(), options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_TRUE(model->articulated);
+  std::vector<std::string> warnings;
+  const Result<physics::ArticulationDef> def = MakeArticulationDef(*model, &warnings);
+  ASSERT_TRUE(def.ok()) << def.message();
+  ASSERT_EQ(def->links.size(), 3u);
+  EXPECT_EQ(def->links[1].name, "forearm");
+  EXPECT_EQ(def->links[0].mass_properties.mass, 2.0);
+  EXPECT_EQ(def->links[1].mass_properties.mass, 0.5);
+  EXPECT_EQ(def->links[2].mass_properties.mass, 0.25);
+  ASSERT_EQ(def->joints.size(), 2u);
+  const physics::JointDef& elbow = def->joints[0];
+  EXPECT_EQ(elbow.type, physics::JointType::kRevolute);
+  EXPECT_EQ(elbow.parent_link, 0);
+  EXPECT_EQ(elbow.child_link, 1);
+  EXPECT_TRUE(elbow.parent_from_joint.translation.isApprox(Vec3(1, 0, 0), 1e-15));
+  EXPECT_EQ(elbow.lower, -1.0);
+  EXPECT_EQ(elbow.upper, 2.0);
+  EXPECT_EQ(elbow.position, 0.5);
+  const physics::JointDef& slider = def->joints[1];
+  EXPECT_EQ(slider.type, physics::JointType::kPrismatic);
+  // The slider's joint frame in the forearm's frame, whatever the elbow's
+  // initial turn.
+  EXPECT_TRUE(slider.parent_from_joint.translation.isApprox(Vec3(1, 0, 0), 1e-15));
+  EXPECT_TRUE(slider.axis.isApprox(Vec3::UnitY(), 1e-15));
+  // The forearm's sphere, in the forearm's frame.
+  ASSERT_EQ(def->links[1].shapes.size(), 1u);
+  EXPECT_TRUE(def->links[1].shapes[0].body_from_shape.translation.isApprox(Vec3(1, 0, 0), 1e-15));
+  EXPECT_TRUE(warnings.empty());
+
+  std::string planar = ArmUrdf();
+  planar.replace(planar.find("type=\"prismatic\""), 16, "type=\"planar\"");
+  const Result<LoadedModel> refused = LoadUrdfString(planar, options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("joint 'slider' is planar"), std::string::npos);
+}
+
+// A floating joint to 'world' leaves the root free; a movable one is
+// refused by name.
+TEST(UrdfLoaderTest, JointToWorldIsFixedOrFloating) {
+  const auto urdf = [](const std::string& type) {
+    return "<robot name=\"r\"><link name=\"world\"/><joint name=\"to_world\" type=\"" + type +
+           "\"><parent link=\"world\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+           "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>"
+           "<link name=\"b\"><collision><geometry><sphere radius=\"0.1\"/></geometry>"
+           "</collision></link></robot>";
+  };
+  UrdfLoadOptions options;
+  options.articulate = true;
+  Result<LoadedModel> model = LoadUrdfString(urdf("fixed"), options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_TRUE(model->is_static);
+  model = LoadUrdfString(urdf("floating"), options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_FALSE(model->is_static);
+  model = LoadUrdfString(urdf("revolute"), options);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.message(),
+            "joint 'to_world' to link 'world' is revolute; a joint to 'world' must be fixed or "
+            "floating");
 }
 
 }  // namespace

@@ -27,7 +27,8 @@ io::LoadedModel TwoLinkModel() {
   arm.friction_from_urdf = true;
   arm.link_name = "arm";
   model.shapes = {base, arm};
-  model.links = {{"base", Pose::Identity()}, {"arm", Pose{Vec3(1, 0, 0), Quat::Identity()}}};
+  model.links = {{"base", Pose::Identity(), 0.0, {}},
+                 {"arm", Pose{Vec3(1, 0, 0), Quat::Identity()}, 0.0, {}}};
   return model;
 }
 
@@ -98,7 +99,8 @@ TEST(ModelRegistryTest, RegistryResolvesModelsLinksAndBodies) {
   model.name = "thing";
   model.body = physics::BodyId{3, 7};
   model.links = loaded.links;
-  model.shape_links = {"base", "arm"};
+  model.bodies = {model.body};
+  model.body_shape_links = {{"base", "arm"}};
   ASSERT_TRUE(registry.Add(model).ok());
   EXPECT_EQ(registry.Add(model).message(), "a model named 'thing' already exists");
   auto frame = registry.ResolveFrame("thing");

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "rigid_body_sim/io/convex_hull.h"
 #include "rigid_body_sim/io/mesh_loader.h"
+#include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/mass_properties.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/shape.h"
@@ -67,13 +69,17 @@ struct UrdfLoadOptions {
   // Maps package:// and file:// URIs of meshes to local paths. When empty,
   // ResolveFileUri is used, so package:// URIs are an error.
   UriResolver resolver;
-  // Movable joints are not simulated yet. When true, revolute, continuous and
-  // prismatic joints are welded at their position in `joint_positions` (rad
-  // or m; 0 for joints not listed), each with a warning; when false they are
-  // refused. Floating and planar joints are always refused.
+  // Revolute, continuous and prismatic joints: simulated (LoadedModel's
+  // `articulated`, see MakeArticulationDef) when `articulate` is true;
+  // otherwise welded at their position in `joint_positions` (rad or m; 0
+  // for joints not listed), each with a warning, when `weld_movable_joints`
+  // is true; otherwise refused. Floating and planar joints between links are
+  // always refused.
+  bool articulate = false;
   bool weld_movable_joints = false;
-  // By joint name; every name must be a weldable movable joint of the model
-  // and every value within the joint's limits, or the load fails.
+  // By joint name, the initial position of each movable joint (0 when not
+  // listed); every name must be a movable joint of the model that mimics
+  // none, and every value within the joint's limits, or the load fails.
   std::map<std::string, double> joint_positions;
 };
 
@@ -87,17 +93,29 @@ struct LoadedShape {
 // A link merged into the body and where it sits in it.
 struct LinkFrame {
   std::string link_name;
-  physics::Pose root_from_link;
+  physics::Pose root_from_link;  // with every movable joint at its initial position
   double mass = 0.0;  // kg: the <inertial> mass, else from geometry at the default density
+  physics::MassProperties mass_in_link;  // link frame; mass 0 for a massless link
 };
 
-// A joint of the model, all of them welded into the one body.
+// A joint of the model, as URDF states it.
 struct JointInfo {
   std::string name;
   std::string type;  // URDF type: fixed, revolute, continuous or prismatic
   std::string parent_link;
   std::string child_link;
-  double position = 0.0;  // rad or m, the welded position; 0 for fixed joints
+  double position = 0.0;  // rad or m, the initial (or welded) position; 0 for fixed joints
+  physics::Pose parent_from_joint;                          // <origin>, parent link frame
+  physics::Vec3 axis = physics::Vec3::UnitX();              // unit, joint frame
+  double lower = -std::numeric_limits<double>::infinity();  // rad or m
+  double upper = std::numeric_limits<double>::infinity();
+  double effort = std::numeric_limits<double>::infinity();    // N m or N
+  double velocity = std::numeric_limits<double>::infinity();  // rad/s or m/s
+  double damping = 0.0;                                       // <dynamics damping>
+  double friction = 0.0;                                      // <dynamics friction>
+  std::string mimic_joint;                                    // <mimic joint>, or empty
+  double mimic_multiplier = 1.0;
+  double mimic_offset = 0.0;
 };
 
 // One rigid body made of all links of a URDF model joined by fixed joints.
@@ -112,7 +130,10 @@ struct LoadedModel {
   std::vector<LoadedShape> shapes;          // root-link frame
   std::vector<LinkFrame> links;             // every link of the body, root first
   std::vector<JointInfo> joints;            // every joint but the one to `world`, tree order
-  std::vector<std::string> warnings;        // e.g. inertia computed from geometry
+  // Movable joints are simulated (UrdfLoadOptions::articulate and at least
+  // one movable joint): the model becomes an articulation.
+  bool articulated = false;
+  std::vector<std::string> warnings;  // e.g. inertia computed from geometry
 };
 
 // Parses a URDF document. Fails, naming the element, on malformed XML,
@@ -123,6 +144,14 @@ struct LoadedModel {
 // taken relative to the working directory.
 physics::Result<LoadedModel> LoadUrdfString(const std::string& xml,
                                             const UrdfLoadOptions& options = {});
+
+// The articulation of an articulated model: one link per group of URDF
+// links joined by fixed joints (its frame the group's first link), one
+// joint per movable joint, in tree order. A group without mass gets 1 g
+// (a warning in `warnings`). Shapes, materials and user data are the
+// caller's to adjust.
+physics::Result<physics::ArticulationDef> MakeArticulationDef(const LoadedModel& model,
+                                                              std::vector<std::string>* warnings);
 
 // As LoadUrdfString, reading the file at `path`; relative mesh paths are
 // taken relative to the directory of the URDF file.

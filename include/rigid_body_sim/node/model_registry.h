@@ -33,9 +33,12 @@ struct ModelSpec {
   bool is_static = false;
   double friction = -1.0;     // >= 0 overrides every shape; < 0: URDF or the default
   double restitution = -1.0;  // >= 0 overrides every shape; < 0: the default
-  // rad or m by movable joint name; they are welded there (not simulated
-  // yet). The loader checks names and limits.
+  // rad or m by movable joint name: where the joints start (and return to
+  // on a reset). The loader checks names and limits.
   std::map<std::string, double> joint_positions;
+  // Links of an articulated model collide with each other (never two
+  // joined by one joint), like Gazebo's <self_collide>.
+  bool self_collide = false;
 };
 
 // Materials of shapes the spec and the URDF leave open.
@@ -55,6 +58,14 @@ physics::Status ValidateModelName(const std::string& name);
 physics::Result<physics::BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
                                               const MaterialDefaults& defaults);
 
+// The articulation of an articulated model placed as the spec asks, with
+// the materials MakeBodyDef would give its shapes; `warnings` gets the
+// loader's notes on links without mass.
+physics::Result<physics::ArticulationDef> MakeArticulationSpec(const io::LoadedModel& model,
+                                                               const ModelSpec& spec,
+                                                               const MaterialDefaults& defaults,
+                                                               std::vector<std::string>* warnings);
+
 // Rigid-body velocity transfer between two frames of one body:
 // v_link = v_root + w x (p_link - p_root), w shared.
 FrameState LinkStateFromRoot(const FrameState& root, const physics::Pose& root_from_link);
@@ -65,13 +76,24 @@ std::string FrameName(const std::string& model, const std::string& link);
 
 struct Model {
   std::string name;
-  physics::BodyId body;
+  physics::BodyId body;  // the root link's body
+  // An articulated model's articulation (invalid for a rigid model), its
+  // bodies (one per articulation link; {body} for a rigid model), each
+  // body's shapes' links, and per entry of `links` its body and pose in it.
+  physics::ArticulationId articulation;
+  std::vector<physics::BodyId> bodies;
+  std::vector<std::vector<std::string>> body_shape_links;
+  std::vector<int> link_body;
+  std::vector<physics::Pose> body_from_link;
+  // Movable joints in tree order (mimic joints included): joint_states'
+  // names, and where each started.
+  std::vector<std::string> joint_names;
+  std::vector<double> spawn_joint_positions;
   bool is_static = false;
-  std::vector<io::LinkFrame> links;      // every link of the body, root first, with masses
-  std::vector<io::JointInfo> joints;     // every joint but one to 'world'
-  double mass = 0.0;                     // kg, of the body; 0 when static
-  std::vector<std::string> shape_links;  // per shape of the body, the link it came from
-  FrameState spawn_state;                // of the root link, restored by a reset
+  std::vector<io::LinkFrame> links;   // every link of the body, root first, with masses
+  std::vector<io::JointInfo> joints;  // every joint but one to 'world'
+  double mass = 0.0;                  // kg, of the body; 0 when static
+  FrameState spawn_state;             // of the root link, restored by a reset
 };
 
 // A frame of a model: the model and one of its links.

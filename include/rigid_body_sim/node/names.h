@@ -23,12 +23,17 @@ inline constexpr char kGetWorldPropertiesService[] = "get_world_properties";
 inline constexpr char kGetModelPropertiesService[] = "get_model_properties";
 inline constexpr char kResetWorldService[] = "reset_world";
 inline constexpr char kResetSimulationService[] = "reset_simulation";
+inline constexpr char kSetJointStateService[] = "set_joint_state";
 
 // Topics (~).
 inline constexpr char kContactsTopic[] = "contacts";
 inline constexpr char kStatesTopic[] = "states";
 inline constexpr char kContactMarkersTopic[] = "contact_markers";
 inline constexpr char kBodyMarkersTopic[] = "body_markers";
+// Per articulated model, under ~<model>/: sensor_msgs/JointState out and in.
+inline constexpr char kJointStatesTopic[] = "joint_states";
+inline constexpr char kJointCommandTopic[] = "joint_command";
+inline constexpr char kJointTrajectoryTopic[] = "joint_trajectory";
 
 // Global topics (tf2_ros's broadcasters publish /tf and /tf_static).
 inline constexpr char kTfTopic[] = "/tf";

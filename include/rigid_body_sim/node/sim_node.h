@@ -18,11 +18,13 @@
 
 #include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
+#include <trajectory_msgs/JointTrajectory.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <boost/thread/recursive_mutex.hpp>
 
@@ -35,11 +37,13 @@
 #include "rigid_body_sim/GetWorldProperties.h"
 #include "rigid_body_sim/ModelStates.h"
 #include "rigid_body_sim/PhysicsConfig.h"
+#include "rigid_body_sim/SetJointState.h"
 #include "rigid_body_sim/SetPhysics.h"
 #include "rigid_body_sim/SetState.h"
 #include "rigid_body_sim/Spawn.h"
 #include "rigid_body_sim/Step.h"
 #include "rigid_body_sim/io/urdf_loader.h"
+#include "rigid_body_sim/node/joint_trajectory.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
 #include "rigid_body_sim/node/sim_diagnostics.h"
@@ -82,7 +86,8 @@ class SimNode {
     std::optional<rigid_body_sim::Contacts> contacts;
     std::optional<visualization_msgs::MarkerArray> contact_markers;
     std::optional<visualization_msgs::MarkerArray> body_markers;
-    std::optional<double> clock;    // s of sim time
+    std::vector<std::pair<std::string, sensor_msgs::JointState>> joint_states;  // by model
+    std::optional<double> clock;                                                // s of sim time
     bool diagnostics = false;       // a diagnostics window closed
     bool tf_is_new_frame = false;   // tf holds only the frames of a new model
     std::uint64_t reset_count = 0;  // resets before the messages were built
@@ -97,6 +102,27 @@ class SimNode {
   physics::Result<std::vector<std::string>> SpawnModel(const ModelSpec& spec);
   std::string DescribeOverlaps(const std::string& model_name);
   physics::Result<io::LoadedModel> LoadModel(const ModelSpec& spec) const;
+  physics::Status CreateBodyLocked(const physics::BodyDef& def, const io::LoadedModel& loaded,
+                                   Model* model);
+  physics::Status CreateArticulationLocked(const physics::ArticulationDef& def,
+                                           const io::LoadedModel& loaded, Model* model);
+  // The articulated models' topics (sim_joints.cc): ~<model>/joint_states
+  // and ~<model>/joint_command.
+  void AdvertiseJointTopicsLocked(const Model& model);
+  void RemoveJointTopics(const std::string& model_name);
+  void OnJointCommand(const std::string& model_name, const sensor_msgs::JointState& command);
+  void OnJointTrajectory(const std::string& model_name,
+                         const trajectory_msgs::JointTrajectory& trajectory);
+  // Before each step: every active trajectory's position and velocity at
+  // the step's end become its joints' servo commands.
+  void FollowTrajectoriesLocked();
+  bool OnSetJointState(rigid_body_sim::SetJointState::Request& request,
+                       rigid_body_sim::SetJointState::Response& response);
+  void FillJointStatesLocked(const ros::Time& stamp, Outbox* outbox) const;
+  void PublishJointStates(const Outbox& outbox);
+  // Puts an articulated model's joints back where it spawned, at rest,
+  // with no command.
+  physics::Status ResetJointsLocked(const Model& model);
 
   bool OnSpawn(rigid_body_sim::Spawn::Request& request, rigid_body_sim::Spawn::Response& response);
   bool OnDelete(rigid_body_sim::Delete::Request& request,
@@ -149,7 +175,8 @@ class SimNode {
   // Logs and records the bodies the last step froze (World::non_finite_bodies).
   void ReportFrozenLocked();
   void ReanchorLocked();
-  FrameState RootStateLocked(const Model& model) const;
+  // The state of links[link] of the model, from the body that carries it.
+  FrameState LinkStateLocked(const Model& model, std::size_t link) const;
   // The stamp of everything published now: sim time when /use_sim_time is
   // true (listeners follow our /clock), wall time otherwise, so that tf
   // listeners never extrapolate.
@@ -160,6 +187,8 @@ class SimNode {
   void FillPeriodicLocked(Outbox* outbox);
   void FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const;
   tf2_msgs::TFMessage ModelTfLocked(const Model& model) const;
+  void AppendModelTfLocked(const Model& model, const ros::Time& stamp,
+                           tf2_msgs::TFMessage* tf) const;
   tf2_msgs::TFMessage StaticTfLocked() const;
   void LogStatusLocked(Clock::time_point now);
   void CloseDiagnosticsWindowLocked(Clock::time_point now);
@@ -182,6 +211,19 @@ class SimNode {
   ros::Publisher contact_markers_publisher_;
   ros::Publisher body_markers_publisher_;
   std::vector<ros::ServiceServer> services_;
+  struct JointTopics {
+    ros::Publisher states;
+    ros::Subscriber command;
+    ros::Subscriber trajectory;
+  };
+  struct ActiveTrajectory {
+    std::vector<int> joints;  // indices into the model's joint_names
+    JointTrajectory plan;
+    double start_time = 0.0;  // s of sim time
+  };
+  std::map<std::string, ActiveTrajectory> trajectories_;  // by model, under mutex_
+  std::mutex joint_topics_mutex_;
+  std::map<std::string, JointTopics> joint_topics_;  // by model
   std::unique_ptr<SimDiagnostics> diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<rigid_body_sim::PhysicsConfig>> reconfigure_;

@@ -69,6 +69,11 @@ struct Body {
   double last_angular_speed = 0.0;  // rad/s
   bool has_proxy = false;           // registered with the broad phase
   bool disabled = false;            // its state became non-finite; out of the simulation
+  // The articulation the body is a link of, and which link; -1 for a free
+  // body. A link moves with its articulation's joint coordinates, never on
+  // its own.
+  std::int32_t articulation = -1;
+  std::int32_t link = -1;
   std::uint64_t user_data = 0;
   std::uint32_t generation = 0;
   bool in_use = false;

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/result.h"
@@ -74,6 +75,25 @@ class World {
   // velocity, out of the simulation (no contacts), so no NaN reaches its
   // neighbours, until SetState gives it a state again.
   const std::vector<BodyId>& non_finite_bodies() const;
+
+  // Articulations (articulation.h). Creating one validates the whole
+  // definition and creates one body per link (links[i] is the i-th id of
+  // ArticulationLinks); a refused one leaves the world unchanged. A link's
+  // body is read like any other; SetState on it moves the whole
+  // articulation rigidly (its joints stop), forces on it act through the
+  // joints, and DestroyBody refuses it.
+  Result<ArticulationId> CreateArticulation(const ArticulationDef& def);
+  Status DestroyArticulation(ArticulationId id);
+  bool IsValid(ArticulationId id) const;
+  std::vector<BodyId> ArticulationLinks(ArticulationId id) const;
+  // Per joint, in the definition's order.
+  std::vector<JointState> GetJointStates(ArticulationId id) const;
+  // Positions and velocities of every joint (mimic joints' are ignored);
+  // refuses non-finite values and positions outside the limits.
+  Status SetJointStates(ArticulationId id, const std::vector<double>& positions,
+                        const std::vector<double>& velocities);
+  Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command);
+  Status SetServoGains(ArticulationId id, const ServoGains& gains);
 
   // The contact points of the last step.
   const std::vector<ContactReport>& contacts() const;

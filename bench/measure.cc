@@ -1,0 +1,322 @@
+#include "measure.h"
+
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <utility>
+
+namespace rigid_body_sim::bench {
+namespace {
+
+// The velocity motors of a scene's articulations, joints numbered over all
+// of them (Engine), and the driven joint's commanded angle.
+class MotorSchedule {
+ public:
+  explicit MotorSchedule(const Scene& scene) : driven_(scene.driven_joint) {
+    int joint = 0;
+    for (const BenchArticulation& articulation : scene.articulations) {
+      for (std::size_t j = 0; j < articulation.joints.size(); ++j, ++joint) {
+        if (j < articulation.motors.size() && !articulation.motors[j].empty()) {
+          motors_.push_back(Motor{joint, articulation.motors[j], 0.0, false});
+        }
+      }
+    }
+  }
+
+  // Sets every motor's velocity for the step starting at time t (s).
+  void Apply(double t, Engine* engine) {
+    for (Motor& motor : motors_) {
+      double velocity = motor.phases.front().velocity;
+      for (const MotorPhase& phase : motor.phases) {
+        if (phase.from_seconds <= t + 1e-9) velocity = phase.velocity;
+      }
+      if (!motor.set || velocity != motor.velocity) engine->SetMotorVelocity(motor.joint, velocity);
+      motor.velocity = velocity;
+      motor.set = true;
+      if (motor.joint == driven_) commanded_ += velocity * kTimeStep;
+    }
+  }
+
+  double commanded() const { return commanded_; }  // rad, the driven joint's so far
+
+ private:
+  struct Motor {
+    int joint;
+    std::vector<MotorPhase> phases;
+    double velocity;
+    bool set;
+  };
+  int driven_;
+  std::vector<Motor> motors_;
+  double commanded_ = 0.0;
+};
+
+// The first apex of a bounce: the highest point between leaving the ground
+// and falling again.
+struct ApexTracker {
+  bool fell = false;
+  bool rose = false;
+  bool found = false;
+  double highest = -1e300;
+
+  void Observe(double z, double vz) {
+    if (found) return;
+    if (vz < -0.1) fell = true;
+    if (fell && vz > 0.0) rose = true;
+    if (rose) {
+      highest = std::max(highest, z);
+      if (vz <= 0.0) found = true;
+    }
+  }
+};
+
+void AddStageTimes(const Engine& engine, int step, int window_steps, double step_ms,
+                   RunResult* result) {
+  const StageTimes stages = engine.LastStageTimes();
+  result->broad_phase_ms += stages.broad_phase_ms;
+  result->narrow_phase_ms += stages.narrow_phase_ms;
+  result->solver_ms += stages.solver_ms;
+  result->integrator_ms += stages.integrator_ms;
+  if (stages.solver_points > 0) {
+    result->solver_point_iterations += static_cast<double>(stages.point_iterations);
+    result->solver_rows_ms += stages.solver_ms;
+    ++result->contact_steps;
+    result->contact_steps_ms += step_ms;
+    if (step < window_steps) {
+      ++result->window_contact_steps;
+      result->window_contact_ms += step_ms;
+    }
+  }
+}
+
+// The scene's figures from the engine's state at the end of the run.
+void FinishRun(const Scene& scene, const Engine& engine, RunResult* result) {
+  const double steps = result->steps;
+  result->step_ms /= steps;
+  result->broad_phase_ms /= steps;
+  result->narrow_phase_ms /= steps;
+  result->solver_ms /= steps;
+  result->integrator_ms /= steps;
+  result->final_kinetic_energy = engine.KineticEnergy();
+  result->final_penetration = engine.MaxPenetration();
+  if (scene.kind == SceneKind::kArmPush) {
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+      const Vec3 moved =
+          engine.Position(static_cast<int>(i)) - scene.bodies[i].world_from_body.translation;
+      result->boxes_moved += moved.head<2>().norm() > 0.01;
+    }
+  }
+  if (scene.top_body < 0) return;
+  const Vec3 top_start = scene.bodies[scene.top_body].world_from_body.translation;
+  const Vec3 top_end = engine.Position(scene.top_body);
+  if (scene.kind == SceneKind::kPile) result->drift = (top_end - top_start).head<2>().norm();
+  if (scene.kind == SceneKind::kPyramid) result->drift = (top_end - top_start).norm();
+  if (scene.kind == SceneKind::kIncline) {
+    const Vec3 downhill = scene.world_from_ground.rotation * Vec3::UnitX();
+    result->slide = (top_end - top_start).dot(downhill);
+  }
+}
+
+RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& settings) {
+  std::unique_ptr<Engine> engine = MakeEngine(kind, scene, settings.overrides);
+  RunResult result;
+  result.steps = static_cast<int>(std::lround(scene.seconds / kTimeStep));
+  result.rows_per_point = engine->RowsPerPoint();
+  const int window_steps =
+      std::min(result.steps, static_cast<int>(std::lround(settings.window_seconds / kTimeStep)));
+  const bool articulated = !scene.articulations.empty();
+  MotorSchedule motors(scene);
+  ApexTracker apex;
+  const double driven_start =
+      scene.driven_joint >= 0 ? engine->JointPosition(scene.driven_joint) : 0.0;
+  double total_ms = 0.0;
+  using Clock = std::chrono::steady_clock;
+  for (int step = 0; step < result.steps; ++step) {
+    motors.Apply(step * kTimeStep, engine.get());
+    const Clock::time_point start = Clock::now();
+    engine->Step();
+    const double step_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    total_ms += step_ms;
+    if (step + 1 == window_steps) result.window_step_ms = total_ms / window_steps;
+    AddStageTimes(*engine, step, window_steps, step_ms, &result);
+    if (engine->AllMovingBodiesAwake()) {
+      ++result.awake_steps;
+      result.awake_ms += step_ms;
+    }
+    result.peak_penetration = std::max(result.peak_penetration, engine->MaxPenetration());
+    if (articulated) {
+      result.joint_separation = std::max(result.joint_separation, engine->JointAnchorSeparation());
+    }
+    if (scene.driven_joint >= 0) {
+      result.driven_swept =
+          std::max(result.driven_swept, engine->JointPosition(scene.driven_joint) - driven_start);
+      result.driven_commanded = std::max(result.driven_commanded, motors.commanded());
+    }
+    if (scene.kind == SceneKind::kBounce) {
+      apex.Observe(engine->Position(0).z(), engine->LinearVelocity(0).z());
+    }
+  }
+  result.step_ms = total_ms;
+  FinishRun(scene, *engine, &result);
+  if (scene.kind == SceneKind::kBounce) {
+    result.apex = apex.found ? apex.highest - scene.bodies[0].sphere_radius : 0.0;
+  }
+  result.ok = true;
+  return result;
+}
+
+// Runs one scene in a child process; returns false when the child failed.
+bool RunInChild(const Scene& scene, EngineKind kind, const RunSettings& settings,
+                RunResult* result) {
+  int fds[2];
+  if (pipe(fds) != 0) return false;
+  std::fflush(stdout);
+  const pid_t pid = fork();
+  if (pid < 0) return false;
+  if (pid == 0) {
+    close(fds[0]);
+    const RunResult child_result = RunScene(scene, kind, settings);
+    const ssize_t written = write(fds[1], &child_result, sizeof(child_result));
+    _exit(written == static_cast<ssize_t>(sizeof(child_result)) ? 0 : 1);
+  }
+  close(fds[1]);
+  RunResult received;
+  std::size_t got = 0;
+  while (got < sizeof(received)) {
+    const ssize_t n =
+        read(fds[0], reinterpret_cast<char*>(&received) + got, sizeof(received) - got);
+    if (n <= 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  close(fds[0]);
+  int status = 0;
+  struct rusage usage;
+  std::memset(&usage, 0, sizeof(usage));
+  wait4(pid, &status, 0, &usage);
+  if (got != sizeof(received) || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return false;
+  *result = received;
+  result->peak_rss_kb = usage.ru_maxrss;
+  return result->ok;
+}
+
+// The top box's drift in a pile is chaotic: a micrometre anywhere at the
+// start changes it several-fold, in Bullet as in ours. Run 0 is the scene as
+// defined; run k > 0 moves every free body by up to kJitter (uniform per
+// axis, seed k, the same for every engine), and the drift reported is the
+// median over the runs.
+constexpr double kJitter = 1e-6;  // m
+
+Scene JitterScene(const Scene& scene, int seed) {
+  Scene jittered = scene;
+  if (seed == 0) return jittered;
+  std::mt19937 random(static_cast<std::uint32_t>(seed));
+  std::uniform_real_distribution<double> offset(-kJitter, kJitter);
+  for (BenchBody& body : jittered.bodies) {
+    body.world_from_body.translation += Vec3(offset(random), offset(random), offset(random));
+  }
+  return jittered;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// Sums up one engine's runs of a scene (none when all failed).
+Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> results) {
+  Summary summary;
+  summary.scene = scene.name;
+  summary.engine = EngineName(kind);
+  summary.bodies = static_cast<int>(scene.bodies.size());
+  for (const BenchArticulation& articulation : scene.articulations) {
+    summary.bodies += static_cast<int>(articulation.links.size()) - 1;  // the moving links
+  }
+  summary.seconds = scene.seconds;
+  if (results.empty()) return summary;
+  // Each quality figure is the median over the runs on its own, so that it
+  // does not depend on which run the machine happened to run fastest; the
+  // times and the stage profile are those of the median run by time.
+  constexpr double RunResult::*kQualityFigures[] = {&RunResult::final_kinetic_energy,
+                                                    &RunResult::final_penetration,
+                                                    &RunResult::peak_penetration,
+                                                    &RunResult::drift,
+                                                    &RunResult::apex,
+                                                    &RunResult::slide,
+                                                    &RunResult::joint_separation,
+                                                    &RunResult::boxes_moved,
+                                                    &RunResult::driven_swept,
+                                                    &RunResult::driven_commanded};
+  std::vector<double> medians;
+  for (double RunResult::*figure : kQualityFigures) {
+    std::vector<double> values;
+    for (const RunResult& result : results) values.push_back(result.*figure);
+    medians.push_back(Median(std::move(values)));
+  }
+  std::vector<double> awake;
+  for (const RunResult& result : results) {
+    if (result.awake_steps > 0) awake.push_back(AwakeStepMs(result));
+    summary.peak_rss_kb = std::max(summary.peak_rss_kb, result.peak_rss_kb);
+  }
+  summary.awake_ms_median = Median(std::move(awake));
+  std::sort(results.begin(), results.end(),
+            [](const RunResult& a, const RunResult& b) { return a.step_ms < b.step_ms; });
+  summary.median = results[results.size() / 2];
+  for (std::size_t k = 0; k < medians.size(); ++k) {
+    summary.median.*kQualityFigures[k] = medians[k];
+  }
+  summary.ms_median = summary.median.step_ms;
+  summary.ms_min = results.front().step_ms;
+  summary.ms_max = results.back().step_ms;
+  return summary;
+}
+
+}  // namespace
+
+std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSettings& settings,
+                                    const std::vector<EngineKind>& engines) {
+  const std::size_t count = engines.size();
+  std::vector<std::vector<RunResult>> results(count);
+  std::vector<std::vector<double>> ratios(count);
+  std::vector<std::vector<double>> awake_ratios(count);
+  for (int run = 0; run < runs; ++run) {
+    const Scene jittered = JitterScene(scene, run);
+    std::vector<RunResult> this_run(count);
+    std::vector<bool> ok(count);
+    for (std::size_t e = 0; e < count; ++e) {
+      ok[e] = RunInChild(jittered, engines[e], settings, &this_run[e]);
+      if (ok[e]) {
+        results[e].push_back(this_run[e]);
+      } else {
+        std::fprintf(stderr, "%s/%s: run %d failed\n", scene.name.c_str(),
+                     EngineName(engines[e]).c_str(), run);
+      }
+    }
+    // Ours is engines[0]: its ratio to each other engine in this run.
+    for (std::size_t e = 1; e < count && ok[0]; ++e) {
+      if (!ok[e]) continue;
+      if (this_run[e].step_ms > 0.0) ratios[e].push_back(this_run[0].step_ms / this_run[e].step_ms);
+      if (AwakeStepMs(this_run[0]) > 0.0 && AwakeStepMs(this_run[e]) > 0.0) {
+        awake_ratios[e].push_back(AwakeStepMs(this_run[0]) / AwakeStepMs(this_run[e]));
+      }
+    }
+  }
+  std::vector<Summary> summaries;
+  for (std::size_t e = 0; e < count; ++e) {
+    summaries.push_back(Summarize(scene, engines[e], std::move(results[e])));
+    summaries.back().ours_over_this = Median(std::move(ratios[e]));
+    summaries.back().ours_over_this_awake = Median(std::move(awake_ratios[e]));
+  }
+  return summaries;
+}
+
+}  // namespace rigid_body_sim::bench

@@ -1,0 +1,45 @@
+// A joint trajectory followed in sim time: points with positions and
+// (optionally) velocities, interpolated by cubic Hermite segments, so the
+// commanded position is continuous in velocity. ROS-free.
+#ifndef RIGID_BODY_SIM_NODE_JOINT_TRAJECTORY_H_
+#define RIGID_BODY_SIM_NODE_JOINT_TRAJECTORY_H_
+
+#include <vector>
+
+#include "rigid_body_sim/physics/result.h"
+
+namespace rigid_body_sim::node {
+
+struct TrajectoryPoint {
+  double time = 0.0;               // s from the trajectory's start
+  std::vector<double> positions;   // rad or m, one per joint
+  std::vector<double> velocities;  // rad/s or m/s, one per joint, or empty
+};
+
+struct TrajectorySample {
+  std::vector<double> positions;
+  std::vector<double> velocities;
+};
+
+class JointTrajectory {
+ public:
+  // `start` holds the joints' positions and velocities when the trajectory
+  // begins (time 0); `points` must have strictly increasing times > 0 (a
+  // first point at time 0 replaces the start) and one finite value per
+  // joint. Velocities left out are estimated: the mean of the slopes to
+  // the neighbouring points, 0 at the last point.
+  static physics::Result<JointTrajectory> Make(const TrajectoryPoint& start,
+                                               std::vector<TrajectoryPoint> points);
+
+  // The commanded positions and velocities at time t (s from the start);
+  // after the last point, its positions at rest.
+  TrajectorySample Sample(double t) const;
+  double duration() const { return points_.back().time; }
+
+ private:
+  std::vector<TrajectoryPoint> points_;  // the start first
+};
+
+}  // namespace rigid_body_sim::node
+
+#endif  // RIGID_BODY_SIM_NODE_JOINT_TRAJECTORY_H_

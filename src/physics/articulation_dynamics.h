@@ -1,0 +1,112 @@
+// The dynamics of one articulation in joint coordinates: forward kinematics,
+// link Jacobians, the joint-space inertia matrix and the generalized forces
+// (Featherstone 2008, "Rigid Body Dynamics Algorithms", chapter 6, the
+// composite-rigid-body formulation M(q) u' = Q(q, u); its equations are in
+// docs/design.md, "Articulated bodies").
+#ifndef RIGID_BODY_SIM_PHYSICS_ARTICULATION_DYNAMICS_H_
+#define RIGID_BODY_SIM_PHYSICS_ARTICULATION_DYNAMICS_H_
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rigid_body_sim/physics/articulation.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+using JacobianRows = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // linear (3) then angular (3)
+
+struct ArticulationLink {
+  std::uint32_t body = 0;                // the link's Body in the world
+  int parent_joint = -1;                 // -1 for the base
+  double mass = 0.0;                     // kg
+  Vec3 com_link = Vec3::Zero();          // m, centre of mass in the link frame
+  Mat3 inertia_link = Mat3::Identity();  // kg m^2, about the centre of mass, link frame
+  Vec3 force = Vec3::Zero();   // N, world, applied over the next step at the centre of mass
+  Vec3 torque = Vec3::Zero();  // N m, world
+};
+
+struct ArticulationJoint {
+  JointDef def;
+  int dof = -1;  // index into the joint velocities; -1 for a mimic joint
+  JointCommand command;
+  double effort = 0.0;  // N m or N transmitted in the last step
+  // 1 + the sum of its mimics' squared multipliers: the generalized force on
+  // its dof when it and each mimic exert the same effort (scaled).
+  double effort_scale = 1.0;
+};
+
+// The state integrated over time: the base (its centre of mass and
+// orientation, velocities when floating) and the joints' positions and
+// velocities. u = (v_com, omega) of the base, when floating, then one
+// velocity per joint degree of freedom.
+struct ArticulationState {
+  Vec3 base_com = Vec3::Zero();           // m, world
+  Quat base_rotation = Quat::Identity();  // world_from_base link
+  Eigen::VectorXd q;                      // joint dof positions, rad or m
+  Eigen::VectorXd u;                      // base velocities (if floating), then joint dofs
+};
+
+struct ArticulationModel {
+  std::vector<ArticulationLink> links;
+  std::vector<ArticulationJoint> joints;
+  bool fixed_base = true;
+  bool self_collide = false;
+  int base_dofs = 0;   // 6 when floating
+  int joint_dofs = 0;  // movable joints that mimic none
+  int DofCount() const { return base_dofs + joint_dofs; }
+};
+
+// Where every link is and how it moves, for one state.
+struct ArticulationKinematics {
+  std::vector<Pose> world_from_link;
+  std::vector<Vec3> com_world;         // m
+  std::vector<Mat3> inertia_world;     // kg m^2
+  std::vector<Vec3> linear_velocity;   // m/s, of the centre of mass
+  std::vector<Vec3> angular_velocity;  // rad/s
+  std::vector<Vec3> joint_axis_world;
+  std::vector<Vec3> joint_anchor_world;  // m, the joint frame's origin
+  std::vector<double> joint_position;    // rad or m, every joint (mimics included)
+  std::vector<double> joint_velocity;
+  std::vector<JacobianRows> jacobian;  // per link: (v_com, omega) = J u
+};
+
+// A joint's position and velocity from the state (mimic joints follow their
+// leader).
+double JointPosition(const ArticulationModel& model, const ArticulationState& state, int joint);
+double JointVelocity(const ArticulationModel& model, const ArticulationState& state, int joint);
+
+// Forward kinematics, velocities and Jacobians by one pass from the base to
+// the leaves.
+void ComputeKinematics(const ArticulationModel& model, const ArticulationState& state,
+                       ArticulationKinematics* kinematics);
+
+// The joint-space inertia M = sum_i J_i^T diag(m_i 1, I_i) J_i, and the
+// generalized force Q = sum_i J_i^T (m_i g + F_i - m_i a_i, T_i - I_i alpha_i
+// - omega_i x I_i omega_i) + tau, where (a_i, alpha_i) are the link
+// accelerations for u' = 0 (velocity products only) and tau the joints'
+// efforts less their damping. `joint_efforts` is per dof.
+struct JointSpaceDynamics {
+  Eigen::MatrixXd mass;
+  Eigen::VectorXd force;
+};
+void ComputeDynamics(const ArticulationModel& model, const ArticulationState& state,
+                     const ArticulationKinematics& kinematics, const Vec3& gravity,
+                     const Eigen::VectorXd& joint_efforts, JointSpaceDynamics* dynamics);
+
+// The state advanced by h with velocities u: joint positions by h u, the
+// base by h v and a turn of h omega.
+ArticulationState Advance(const ArticulationModel& model, const ArticulationState& state,
+                          const Eigen::VectorXd& u, double h);
+
+// One step of the unconstrained motion by classical Runge-Kutta (fourth
+// order) on (q, u), efforts held constant over the step.
+ArticulationState StepFreeMotion(const ArticulationModel& model, const ArticulationState& state,
+                                 const Vec3& gravity, const Eigen::VectorXd& joint_efforts,
+                                 double dt);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_ARTICULATION_DYNAMICS_H_

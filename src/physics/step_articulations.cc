@@ -1,0 +1,351 @@
+// The articulations' part of stages 4 and 5 of WorldImpl::Step: their
+// motion over the step in joint coordinates, and the rows of their contacts,
+// limits, servos, motors and joint friction, solved together
+// (docs/design.md, "Articulated bodies").
+//
+// An articulation with no row this step moves freely by RK4 on
+// M(q) u' = Q(q, u), fourth-order exact. One with rows takes the
+// velocity-level step of the contact problem: u* = u + dt (M + dt B)^-1 Q
+// (damping B implicit), then impulses u+ = u* + M^-1 J^T lambda with every
+// row's conditions on u+, and q+ = q + dt u+. A row's condition on u+ is one
+// on q+, since the joint coordinates are linear in u over the step: a limit
+// row u+ >= (lower - q) / dt stops the joint exactly at its limit, without
+// bounce.
+#include <algorithm>
+#include <cmath>
+
+#include "physics/world_impl.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+constexpr int kMaxSweeps = 200;
+constexpr double kSweepTolerance = 1e-9;
+// The solver's state is refused beyond this size, as the step guard refuses
+// a body's (a step's products could overflow).
+constexpr double kMaxMagnitude = 1e100;
+
+bool StateIsSane(const ArticulationState& state) {
+  return state.base_com.allFinite() && IsFinite(state.base_rotation) && state.q.allFinite() &&
+         state.u.allFinite() && state.base_com.cwiseAbs().maxCoeff() < kMaxMagnitude &&
+         (state.q.size() == 0 || state.q.cwiseAbs().maxCoeff() < kMaxMagnitude) &&
+         (state.u.size() == 0 || state.u.cwiseAbs().maxCoeff() < kMaxMagnitude);
+}
+
+Eigen::VectorXd Unit(int size, int index, double sign) {
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(size);
+  e[index] = sign;
+  return e;
+}
+
+// The generalized efforts commanded directly, per dof: each joint's
+// command clamped to its limit, which its mimics exert too (scaled by their
+// multipliers), so a dof with mimics gets effort_scale times it.
+Eigen::VectorXd CommandedEfforts(const ArticulationModel& model) {
+  Eigen::VectorXd efforts = Eigen::VectorXd::Zero(model.joint_dofs);
+  for (const ArticulationJoint& joint : model.joints) {
+    if (joint.dof < 0 || joint.command.mode != JointCommandMode::kEffort) continue;
+    efforts[joint.dof] =
+        joint.effort_scale *
+        std::clamp(joint.command.effort, -joint.def.effort_limit, joint.def.effort_limit);
+  }
+  return efforts;
+}
+
+}  // namespace
+
+bool WorldImpl::SkipsPair(const Body& a, const Body& b) const {
+  if (a.articulation < 0 || a.articulation != b.articulation) return false;
+  const ArticulationModel& model = articulations_[a.articulation].model;
+  if (!model.self_collide) return true;
+  const auto joined = [&model](int child, int parent) {
+    const int joint = model.links[child].parent_joint;
+    return joint >= 0 && model.joints[joint].def.parent_link == parent;
+  };
+  return joined(a.link, b.link) || joined(b.link, a.link);
+}
+
+void WorldImpl::SplitLinkPairs(const std::vector<ShapePairContact*>& pairs) {
+  rigid_pairs_.clear();
+  link_pairs_.clear();
+  for (ShapePairContact* pair : pairs) {
+    const bool link =
+        bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0;
+    (link ? link_pairs_ : rigid_pairs_).push_back(pair);
+  }
+}
+
+// Per movable joint: its limits when the free step would reach them, its
+// speed limit when the free step would exceed it, its friction, and its
+// command's servo or motor. Efforts commanded directly are in Q already.
+void WorldImpl::AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free,
+                                    double dt) {
+  const ArticulationEntry& entry = articulations_[index];
+  const ArticulationModel& model = entry.model;
+  const int n = model.DofCount();
+  for (const ArticulationJoint& joint : model.joints) {
+    if (joint.dof < 0) continue;
+    const JointDef& def = joint.def;
+    const int column = model.base_dofs + joint.dof;
+    const double q = entry.state.q[joint.dof];
+    const double u = u_free[column];
+    const double reach = dt * (std::abs(u) + std::abs(u - entry.state.u[column])) + 1e-12;
+    auto add = [&](double sign, RowKind kind, double target, double bound, double softness) {
+      ConstraintRow row;
+      row.articulation = static_cast<int>(index);
+      row.joint = static_cast<int>(&joint - model.joints.data());
+      row.joint_sign = sign;
+      row.a = articulation_solver_.ArticulationSide(slot, Unit(n, column, sign));
+      row.kind = kind;
+      row.target = target;
+      row.lower = -bound;
+      row.upper = bound;
+      row.softness = softness;
+      articulation_solver_.AddRow(std::move(row));
+    };
+    if (q + dt * u < def.lower + reach) add(1.0, RowKind::kNormal, (def.lower - q) / dt, 0.0, 0.0);
+    if (q + dt * u > def.upper - reach) add(-1.0, RowKind::kNormal, (q - def.upper) / dt, 0.0, 0.0);
+    if (std::abs(u) > def.velocity_limit) {
+      add(u > 0.0 ? -1.0 : 1.0, RowKind::kNormal, -def.velocity_limit, 0.0, 0.0);
+    }
+    if (def.friction > 0.0) add(1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
+    // Each of the joints the dof moves may exert its own limit.
+    const double effort_bound = joint.effort_scale * def.effort_limit * dt;
+    if (joint.command.mode == JointCommandMode::kVelocity) {
+      add(1.0, RowKind::kBounded, joint.command.velocity, effort_bound, 0.0);
+    } else if (joint.command.mode == JointCommandMode::kPosition) {
+      // The implicit spring-damper as a soft row (Catto 2011, "Soft
+      // Constraints"): v + gamma lambda = v_cmd - beta (q - q_cmd) / dt with
+      // beta = dt k / (dt k + c) and gamma = 1 / (dt (dt k + c)); its steady
+      // error under a load tau is tau / k.
+      const double kc = dt * entry.gains.stiffness + entry.gains.damping;
+      const double beta = dt * entry.gains.stiffness / kc;
+      const double gamma = 1.0 / (dt * kc);
+      const double target = joint.command.velocity - beta * (q - joint.command.position) / dt;
+      add(1.0, RowKind::kBounded, target, effort_bound, gamma);
+    }
+  }
+}
+
+void WorldImpl::SolveArticulations(double dt) {
+  if (articulations_.empty()) return;
+  articulation_solver_.Reset();
+  std::vector<char> touched(articulations_.size(), 0);
+  for (const ShapePairContact* pair : link_pairs_) {
+    for (const std::uint32_t body : {pair->body_a, pair->body_b}) {
+      if (bodies_[body].articulation >= 0) touched[bodies_[body].articulation] = 1;
+    }
+  }
+  std::vector<int> slot(articulations_.size(), -1);
+  std::vector<ArticulationKinematics> kinematics(articulations_.size());
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    ArticulationEntry& entry = articulations_[i];
+    if (!entry.in_use) continue;
+    ArticulationModel& model = entry.model;
+    for (ArticulationLink& link : model.links) {
+      link.force = bodies_[link.body].force;
+      link.torque = bodies_[link.body].torque;
+    }
+    const Eigen::VectorXd efforts = CommandedEfforts(model);
+    ArticulationKinematics& k = kinematics[i];
+    ComputeKinematics(model, entry.state, &k);
+    JointSpaceDynamics dynamics;
+    ComputeDynamics(model, entry.state, k, settings_.gravity, efforts, &dynamics);
+    Eigen::MatrixXd mass = dynamics.mass;
+    for (const ArticulationJoint& joint : model.joints) {
+      if (joint.dof >= 0)
+        mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += dt * joint.def.damping;
+    }
+    // Damping explicit in Q, implicit in the mass: (M + dt B) u* = M u + dt Q.
+    const Eigen::VectorXd u_free = entry.state.u + mass.llt().solve(dt * dynamics.force);
+    const std::size_t rows_before = articulation_solver_.rows().size();
+    const int candidate = articulation_solver_.AddArticulation(u_free, mass);
+    AddArticulationRows(i, candidate, u_free, dt);
+    const bool has_rows = articulation_solver_.rows().size() > rows_before;
+    const bool stiff_damping = (mass - dynamics.mass).norm() > 0.1 * dynamics.mass.norm();
+    for (ArticulationJoint& joint : model.joints) {
+      joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
+    }
+    if (has_rows || touched[i] || stiff_damping) {
+      slot[i] = candidate;
+    } else {
+      entry.next = StepFreeMotion(model, entry.state, settings_.gravity, efforts, dt);
+    }
+  }
+  AddLinkContactRows(dt, slot, kinematics);
+  articulation_solver_.Solve(kMaxSweeps, kSweepTolerance);
+
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    if (slot[i] < 0) continue;
+    ArticulationEntry& entry = articulations_[i];
+    entry.next =
+        Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
+  }
+  // A joint's effort: its command's, its rows' impulses over dt, less its
+  // damping; shared with its mimics, each taking its multiplier's part.
+  for (const ConstraintRow& row : articulation_solver_.rows()) {
+    if (row.joint < 0) continue;
+    ArticulationEntry& entry = articulations_[row.articulation];
+    entry.model.joints[row.joint].effort += row.joint_sign * row.impulse / dt;
+  }
+  for (ArticulationEntry& entry : articulations_) {
+    if (!entry.in_use) continue;
+    for (ArticulationJoint& joint : entry.model.joints) {
+      if (joint.dof < 0) continue;
+      joint.effort -= joint.def.damping * entry.next.u[entry.model.base_dofs + joint.dof];
+      joint.effort /= joint.effort_scale;
+    }
+    for (ArticulationJoint& joint : entry.model.joints) {
+      if (joint.dof >= 0) continue;
+      joint.effort = joint.def.mimic_multiplier * entry.model.joints[joint.def.mimic_joint].effort;
+    }
+  }
+  for (const ArticulationSolver::BodySlot& slot_body : articulation_solver_.bodies()) {
+    Body& body = bodies_[slot_body.body];
+    if (body.inverse_mass == 0.0 || !body.awake || body.disabled || body.articulation >= 0)
+      continue;
+    const Vec3 linear_change = slot_body.linear_velocity - body.linear_velocity;
+    const Mat3 rotation = body.orientation.toRotationMatrix();
+    const Vec3 angular_momentum = rotation *
+                                  body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+                                  (rotation.transpose() * slot_body.angular_velocity);
+    // A change that resting forces can make within the step (at most the
+    // collision threshold beyond what gravity gives) is a force over it:
+    // the trapezoidal drift keeps it exact, as kinetic friction on a
+    // lifted box. A larger one stops an impact, an impulse at the start of
+    // the step whose whole change drifts.
+    const double resting = settings_.solver.collision_velocity_threshold +
+                           settings_.time_step * settings_.gravity.norm();
+    if (linear_change.norm() > resting) {
+      body.start_linear_velocity += linear_change;
+      body.start_angular_momentum += angular_momentum - body.angular_momentum;
+    }
+    body.linear_momentum = body.mass * slot_body.linear_velocity;
+    body.angular_momentum = angular_momentum;
+    body.UpdateDerived();
+  }
+}
+
+// Per point of a pair with a link: a normal row and two friction rows. The
+// normal row's target follows the rigid bodies' classification: a point
+// touching and closing faster than the collision threshold bounces with
+// restitution, v+ >= -e v-; one apart by s may close it within the step,
+// v+ >= -s / dt (so nothing passes through a link); one penetrating beyond
+// the slop is pushed out by position_correction of its depth per step.
+void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
+                                   const std::vector<ArticulationKinematics>& kinematics) {
+  const SolverSettings& solver = settings_.solver;
+  link_pair_rows_.assign(link_pairs_.size(), -1);
+  for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
+    const ShapePairContact& pair = *link_pairs_[m];
+    const Body& a = bodies_[pair.body_a];
+    const Body& b = bodies_[pair.body_b];
+    const Material& material_a = a.shapes[pair.shape_a].material;
+    const Material& material_b = b.shapes[pair.shape_b].material;
+    const double friction = CombineFriction(material_a.friction, material_b.friction);
+    const double restitution = CombineRestitution(material_a.restitution, material_b.restitution);
+    const Vec3 normal = pair.manifold.normal_world;
+    const std::array<Vec3, 2> tangent = TangentBasis(normal);
+    auto side = [&](std::uint32_t index, const Vec3& direction, const Vec3& point) {
+      const Body& body = bodies_[index];
+      if (body.articulation >= 0) {
+        const int articulation_slot = slot_of_articulation[body.articulation];
+        const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
+        const Vec3 r = point - body.position;
+        const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
+                                    jacobian.bottomRows<3>().transpose() * r.cross(direction);
+        return articulation_solver_.ArticulationSide(articulation_slot, row);
+      }
+      ArticulationSolver::BodySlot body_slot;
+      body_slot.body = index;
+      const bool moves = !body.is_static && body.awake && !body.disabled;
+      if (moves) {
+        body_slot.linear_velocity = body.linear_velocity;
+        body_slot.angular_velocity = body.angular_velocity;
+        body_slot.inverse_mass = body.inverse_mass;
+        body_slot.inverse_inertia_world = body.inverse_inertia_world;
+      }
+      return articulation_solver_.BodySide(articulation_solver_.BodySlotOf(body_slot), direction,
+                                           point - body.position);
+    };
+    for (int i = 0; i < pair.manifold.point_count; ++i) {
+      const ContactPoint& point = pair.manifold.points[i];
+      ConstraintRow normal_row;
+      normal_row.kind = RowKind::kNormal;
+      normal_row.a = side(pair.body_a, normal, point.position_world);
+      normal_row.b = side(pair.body_b, -normal, point.position_world);
+      const double approach = articulation_solver_.RowVelocity(normal_row);
+      const double separation = point.separation;
+      if (separation <= solver.contact_tolerance &&
+          approach < -solver.collision_velocity_threshold) {
+        normal_row.target = -restitution * approach;
+        normal_row.colliding = true;
+      } else if (separation > 0.0) {
+        normal_row.target = -separation / dt;
+      } else {
+        normal_row.target =
+            solver.position_correction * std::max(0.0, -separation - solver.penetration_slop) / dt;
+      }
+      normal_row.impulse = pair.warm_start[i].normal_impulse;
+      const int normal_index = articulation_solver_.AddRow(std::move(normal_row));
+      if (i == 0) link_pair_rows_[m] = normal_index;
+      for (int t = 0; t < 2; ++t) {
+        ConstraintRow tangent_row;
+        tangent_row.kind = RowKind::kTangent;
+        tangent_row.a = side(pair.body_a, tangent[t], point.position_world);
+        tangent_row.b = side(pair.body_b, -tangent[t], point.position_world);
+        tangent_row.normal_row = normal_index;
+        tangent_row.friction = friction;
+        tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
+        articulation_solver_.AddRow(std::move(tangent_row));
+      }
+    }
+  }
+}
+
+// Keeps the link pairs' impulses for next step's warm start and reports
+// their points, as ReportContacts does for the rigid pairs.
+void WorldImpl::ReportLinkContacts(double dt) {
+  const std::vector<ConstraintRow>& rows = articulation_solver_.rows();
+  for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
+    ShapePairContact& pair = *link_pairs_[m];
+    const int first = link_pair_rows_[m];
+    pair.previous_count = first < 0 ? 0 : pair.manifold.point_count;
+    if (first < 0) continue;
+    const std::array<Vec3, 2> tangent = TangentBasis(pair.manifold.normal_world);
+    for (int i = 0; i < pair.manifold.point_count; ++i) {
+      const ConstraintRow& normal = rows[first + 3 * i];
+      const ContactPoint& point = pair.manifold.points[i];
+      pair.previous[i] =
+          CachedImpulse{point.feature,
+                        normal.impulse,
+                        {rows[first + 3 * i + 1].impulse, rows[first + 3 * i + 2].impulse},
+                        point.position_world};
+      const bool touching = point.separation <= settings_.solver.contact_tolerance;
+      if (!touching && normal.impulse <= 0.0) continue;
+      ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, tangent, dt));
+      const bool colliding = normal.colliding && normal.impulse > 0.0;
+      report.type = colliding ? ContactType::kColliding : ContactType::kResting;
+      if (colliding) collision_log_.push_back(report);
+    }
+  }
+}
+
+// Stage 5 for the articulations: each takes the state its solve chose, and
+// its links follow. A state that is not finite (forces that overflowed) is
+// refused: the articulation stays where it was, at rest.
+void WorldImpl::MoveArticulations(double /*dt*/) {
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    ArticulationEntry& entry = articulations_[i];
+    if (!entry.in_use) continue;
+    if (StateIsSane(entry.next)) {
+      entry.state = entry.next;
+    } else {
+      entry.state.u.setZero();
+      entry.next = entry.state;
+    }
+    PlaceLinks(i, entry.state, /*restart=*/false);
+  }
+}
+
+}  // namespace rigid_body_sim::physics

@@ -1,0 +1,462 @@
+// Articulations against closed forms and conservation laws: the pendulum's
+// elliptic-integral period, the double pendulum's energy, a tilted prismatic
+// joint's acceleration, an inelastic joint limit, a 30-link chain with a
+// heavy tip that may not stretch, the servo's and the motor's steady states,
+// and a link resting on the ground.
+#include <cmath>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "scene.h"
+
+namespace rigid_body_sim::physics::testing {
+namespace {
+
+constexpr double kG = 9.81;
+constexpr double kDt = 1.0 / 240.0;
+
+// A slender rod of mass m and length l along -z of its link frame, with a
+// sphere of radius `radius` at its end for contact.
+LinkDef Rod(double mass, double length, double radius = 0.0) {
+  LinkDef link;
+  link.mass_properties.mass = mass;
+  link.mass_properties.center_of_mass = Vec3(0, 0, -length);
+  const double i = mass * 1e-4;  // nearly a point mass at the end
+  link.mass_properties.inertia_about_com = Mat3::Identity() * i;
+  if (radius > 0.0) {
+    ShapeDef shape;
+    shape.geometry = Sphere{radius};
+    shape.body_from_shape.translation = Vec3(0, 0, -length);
+    link.shapes.push_back(shape);
+  }
+  return link;
+}
+
+LinkDef Anchor() {
+  LinkDef link;
+  link.mass_properties.mass = 1.0;
+  link.mass_properties.inertia_about_com = Mat3::Identity() * 0.01;
+  return link;
+}
+
+// Joint k: revolute about y, at the end of the parent rod of `length`
+// (at the base's origin for the first).
+JointDef Hinge(int child, double parent_length, double position) {
+  JointDef joint;
+  joint.name = "j" + std::to_string(child);
+  joint.type = JointType::kContinuous;
+  joint.parent_link = child - 1;
+  joint.child_link = child;
+  joint.parent_from_joint.translation = Vec3(0, 0, -parent_length);
+  joint.axis = Vec3::UnitY();
+  joint.position = position;
+  return joint;
+}
+
+World MakeWorld() {
+  WorldSettings settings;
+  settings.time_step = kDt;
+  settings.gravity = Vec3(0, 0, -kG);
+  return World(settings);
+}
+
+// K(k) = pi / (2 AGM(1, sqrt(1 - k^2))) (Abramowitz and Stegun 1964,
+// 17.6).
+double EllipticK(double k) {
+  double a = 1.0;
+  double b = std::sqrt(1.0 - k * k);
+  for (int i = 0; i < 40; ++i) {
+    const double next = 0.5 * (a + b);
+    b = std::sqrt(a * b);
+    a = next;
+  }
+  return kPi / (2.0 * a);
+}
+
+// The pendulum's period T = 4 sqrt(I_p / (m g l)) K(sin(theta0 / 2)),
+// measured over ten periods from the upward zero crossings of the angle,
+// each placed by linear interpolation between steps.
+TEST(ArticulationTest, PendulumPeriodMatchesTheEllipticIntegral) {
+  for (const double amplitude_degrees : {10.0, 45.0, 90.0}) {
+    SCOPED_TRACE(amplitude_degrees);
+    World world = MakeWorld();
+    const double mass = 1.0;
+    const double length = 1.0;
+    ArticulationDef def;
+    def.fixed_base = true;
+    def.links = {Anchor(), Rod(mass, length)};
+    const double amplitude = amplitude_degrees * kPi / 180.0;
+    def.joints = {Hinge(1, 0.0, amplitude)};
+    const ArticulationId pendulum = world.CreateArticulation(def).value();
+    const double inertia = mass * 1e-4 + mass * length * length;
+    const double expected =
+        4.0 * std::sqrt(inertia / (mass * kG * length)) * EllipticK(std::sin(0.5 * amplitude));
+    std::vector<double> crossings;
+    double previous = amplitude;
+    for (int step = 1; crossings.size() < 11 && step < 100000; ++step) {
+      world.Step();
+      const double angle = world.GetJointStates(pendulum)[0].position;
+      if (previous < 0.0 && angle >= 0.0) {
+        crossings.push_back((step - 1 + previous / (previous - angle)) * kDt);
+      }
+      previous = angle;
+    }
+    ASSERT_EQ(crossings.size(), 11u);
+    const double period = (crossings.back() - crossings.front()) / 10.0;
+    EXPECT_NEAR(period / expected, 1.0, 1e-5);
+  }
+}
+
+double TotalEnergy(const World& world, ArticulationId id) {
+  double energy = 0.0;
+  for (const BodyId link : world.ArticulationLinks(id)) {
+    const Body& body = world.GetBody(link);
+    energy += KineticEnergy(body) + body.mass * kG * body.position.z();
+  }
+  return energy;
+}
+
+// Released from horizontal, the undamped double pendulum is chaotic; its
+// energy is conserved. The drift is measured as a share of the energy above
+// the hanging rest.
+TEST(ArticulationTest, DoublePendulumConservesEnergy) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(1.0, 1.0), Rod(1.0, 1.0)};
+  def.joints = {Hinge(1, 0.0, kPi / 2), Hinge(2, 1.0, 0.0)};
+  const ArticulationId pendulum = world.CreateArticulation(def).value();
+  const double rest = -kG * (1.0 + 2.0);  // both masses hanging: z = -1 and -2
+  const double start = TotalEnergy(world, pendulum);
+  double worst = 0.0;
+  for (int step = 0; step < 20 * 240; ++step) {
+    world.Step();
+    worst = std::max(worst, std::abs(TotalEnergy(world, pendulum) - start));
+  }
+  EXPECT_LT(worst / (start - rest), 2e-3);
+}
+
+// A carriage on a prismatic joint tilted theta from the vertical
+// accelerates at g cos(theta) along it.
+TEST(ArticulationTest, TiltedPrismaticAcceleratesAtGCosTheta) {
+  for (const double theta : {0.0, 0.5, 1.2}) {
+    SCOPED_TRACE(theta);
+    World world = MakeWorld();
+    ArticulationDef def;
+    def.fixed_base = true;
+    LinkDef carriage = Anchor();
+    carriage.mass_properties.mass = 3.0;
+    def.links = {Anchor(), carriage};
+    JointDef slide;
+    slide.name = "slide";
+    slide.type = JointType::kPrismatic;
+    slide.axis = Vec3(std::sin(theta), 0.0, -std::cos(theta));
+    def.joints = {slide};
+    const ArticulationId id = world.CreateArticulation(def).value();
+    const int steps = 240;
+    for (int step = 0; step < steps; ++step) world.Step();
+    const double t = steps * kDt;
+    const double expected = 0.5 * kG * std::cos(theta) * t * t;
+    const JointState state = world.GetJointStates(id)[0];
+    EXPECT_NEAR(state.position / expected, 1.0, 1e-4);
+    EXPECT_NEAR(state.velocity / (kG * std::cos(theta) * t), 1.0, 1e-4);
+  }
+}
+
+// Released 90 degrees from its lower limit, with gravity still pressing it
+// there, the arm stops at the limit: no overshoot beyond 1 mrad, no bounce.
+TEST(ArticulationTest, JointLimitStopsWithoutOvershootOrBounce) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(1.0, 1.0)};
+  // The rod hangs at angle 0; gravity turns it toward 0 from either side.
+  // The lower limit at 0.3 rad is reached moving down, and gravity still
+  // presses the rod against it there.
+  constexpr double kLower = 0.3;
+  JointDef hinge = Hinge(1, 0.0, kLower + kPi / 2);
+  hinge.type = JointType::kRevolute;
+  hinge.lower = kLower;
+  hinge.upper = kLower + kPi / 2;
+  def.joints = {hinge};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  double lowest = kPi;
+  bool reached = false;
+  double highest_after = -kPi;
+  for (int step = 0; step < 3 * 240; ++step) {
+    world.Step();
+    const double angle = world.GetJointStates(id)[0].position;
+    lowest = std::min(lowest, angle);
+    if (angle < kLower + 1e-3) reached = true;
+    if (reached) highest_after = std::max(highest_after, angle);
+  }
+  ASSERT_TRUE(reached);
+  EXPECT_GT(lowest, kLower - 1e-3);
+  EXPECT_LT(highest_after, kLower + 1e-3);
+}
+
+double AnchorSeparation(const World& world, ArticulationId id, const ArticulationDef& def) {
+  const std::vector<BodyId> links = world.ArticulationLinks(id);
+  double worst = 0.0;
+  for (const JointDef& joint : def.joints) {
+    const Vec3 from_parent =
+        world.GetPose(links[joint.parent_link]) * joint.parent_from_joint.translation;
+    const Vec3 child_origin = world.GetPose(links[joint.child_link]).translation;
+    worst = std::max(worst, (from_parent - child_origin).norm());
+  }
+  return worst;
+}
+
+// 30 links of 0.1 kg and a 100 kg tip (1000:1), released horizontal and
+// swinging for 10 s: no joint separates, and energy stays (RK4 loses a
+// little; it may not gain).
+TEST(ArticulationTest, HeavyTippedChainNeverStretches) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links.push_back(Anchor());
+  const int count = 30;
+  for (int i = 1; i <= count; ++i) {
+    def.links.push_back(Rod(i == count ? 100.0 : 0.1, 0.1));
+    def.joints.push_back(Hinge(i, i == 1 ? 0.0 : 0.1, i == 1 ? kPi / 2 : 0.0));
+  }
+  const ArticulationId chain = world.CreateArticulation(def).value();
+  const double start = TotalEnergy(world, chain);
+  double worst = 0.0;
+  for (int step = 0; step < 10 * 240; ++step) {
+    world.Step();
+    worst = std::max(worst, AnchorSeparation(world, chain, def));
+  }
+  EXPECT_LT(worst, 1e-6);
+  const double end = TotalEnergy(world, chain);
+  ASSERT_TRUE(std::isfinite(end));
+  EXPECT_LT(end, start + 1e-3 * std::abs(start));
+}
+
+// A position servo holds a horizontal arm against gravity with the spring's
+// steady error tau / k; a velocity motor turns at its commanded speed.
+TEST(ArticulationTest, ServoHoldsWithinTauOverKAndMotorKeepsItsSpeed) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(2.0, 0.5)};
+  JointDef hinge = Hinge(1, 0.0, kPi / 2);
+  hinge.effort_limit = 100.0;
+  def.joints = {hinge};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  ServoGains gains;
+  ASSERT_TRUE(world.SetServoGains(id, gains).ok());
+  JointCommand hold;
+  hold.mode = JointCommandMode::kPosition;
+  hold.position = kPi / 2;
+  ASSERT_TRUE(world.SetJointCommand(id, 0, hold).ok());
+  for (int step = 0; step < 5 * 240; ++step) world.Step();
+  const double gravity_torque = 2.0 * kG * 0.5;  // horizontal: full lever arm
+  const JointState held = world.GetJointStates(id)[0];
+  EXPECT_NEAR(held.position, kPi / 2 - gravity_torque / gains.stiffness, 1e-6);
+  EXPECT_NEAR(held.effort, gravity_torque, 1e-3 * gravity_torque);
+
+  JointCommand turn;
+  turn.mode = JointCommandMode::kVelocity;
+  turn.velocity = 0.5;
+  ASSERT_TRUE(world.SetJointCommand(id, 0, turn).ok());
+  for (int step = 0; step < 120; ++step) world.Step();
+  EXPECT_NEAR(world.GetJointStates(id)[0].velocity, 0.5, 5e-3);
+}
+
+// A floating two-link articulation (a box with a flap) dropped on the
+// ground comes to rest on it at the box's half height, and a refused
+// definition leaves the world unchanged.
+TEST(ArticulationTest, FloatingArticulationRestsOnTheGround) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(0.8, 0.0));
+  ArticulationDef def;
+  def.world_from_base = Translation(0, 0, 0.5);
+  LinkDef body;
+  body.mass_properties = BoxMassProperties(1000.0, Vec3(0.2, 0.2, 0.2));
+  ShapeDef box;
+  box.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3(0.2, 0.2, 0.2)));
+  box.material = MakeMaterial(0.8, 0.0);
+  body.shapes.push_back(box);
+  LinkDef flap;
+  flap.mass_properties = BoxMassProperties(1000.0, Vec3(0.05, 0.05, 0.05));
+  flap.mass_properties.center_of_mass = Vec3(0, 0, 0.05);
+  JointDef hinge;
+  hinge.name = "flap";
+  hinge.type = JointType::kRevolute;
+  hinge.parent_from_joint.translation = Vec3(0, 0, 0.1);
+  hinge.axis = Vec3::UnitY();
+  hinge.lower = -0.1;
+  hinge.upper = 0.1;
+  def.links = {body, flap};
+  def.joints = {hinge};
+  const std::size_t bodies_before = world.BodyCount();
+  ArticulationDef bad = def;
+  bad.joints[0].position = 0.5;  // outside [-0.1, 0.1]
+  EXPECT_FALSE(world.CreateArticulation(bad).ok());
+  EXPECT_EQ(world.BodyCount(), bodies_before);
+  const ArticulationId id = world.CreateArticulation(def).value();
+  for (int step = 0; step < 2 * 240; ++step) world.Step();
+  const Pose base = world.GetPose(world.ArticulationLinks(id)[0]);
+  EXPECT_NEAR(base.translation.z(), 0.1, 1e-3);
+  EXPECT_LT(world.GetLinearVelocity(world.ArticulationLinks(id)[0]).norm(), 1e-2);
+}
+
+// A damped pendulum at small amplitude: theta'' + (b / I) theta' +
+// (m g l / I) theta = 0, whose peaks decay as exp(-b t / (2 I)). The rate
+// is measured from the first and the tenth peak, each placed by a parabola
+// through the three samples around it.
+TEST(ArticulationTest, DampedPendulumDecaysAtTheClosedFormRate) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Rod(1.0, 1.0)};
+  JointDef hinge = Hinge(1, 0.0, 0.02);
+  hinge.damping = 0.1;  // N m s/rad
+  def.joints = {hinge};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  const double inertia = 1e-4 + 1.0;
+  std::vector<std::pair<double, double>> peaks;  // (time, value)
+  double a = 0.02;
+  double b = 0.02;
+  for (int step = 1; peaks.size() < 10 && step < 100000; ++step) {
+    world.Step();
+    const double c = world.GetJointStates(id)[0].position;
+    if (step >= 2 && b > a && b >= c) {
+      // Vertex of the parabola through (-1, a), (0, b), (1, c).
+      const double offset = 0.5 * (a - c) / (a - 2.0 * b + c);
+      const double value = b - 0.25 * (a - c) * offset;
+      peaks.emplace_back((step - 1 + offset) * kDt, value);
+    }
+    a = b;
+    b = c;
+  }
+  ASSERT_EQ(peaks.size(), 10u);
+  const double rate = std::log(peaks.front().second / peaks.back().second) /
+                      (peaks.back().first - peaks.front().first);
+  EXPECT_NEAR(rate / (hinge.damping / (2.0 * inertia)), 1.0, 1e-2);
+}
+
+LinkDef BoxLink(double mass, const Vec3& size, double friction) {
+  LinkDef link;
+  link.mass_properties = BoxMassProperties(mass / size.prod(), size);
+  ShapeDef shape;
+  shape.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(size));
+  shape.material = MakeMaterial(friction, 0.0);
+  link.shapes.push_back(shape);
+  return link;
+}
+
+JointDef Slider(const std::string& name, int parent, int child, const Vec3& origin,
+                const Vec3& axis) {
+  JointDef joint;
+  joint.name = name;
+  joint.type = JointType::kPrismatic;
+  joint.parent_link = parent;
+  joint.child_link = child;
+  joint.parent_from_joint.translation = origin;
+  joint.axis = axis;
+  joint.lower = -0.5;
+  joint.upper = 0.5;
+  joint.effort_limit = 1000.0;
+  return joint;
+}
+
+// A parallel gripper on a lift: two fingers squeeze a 0.2 kg box with 20 N
+// each (mu = 1), the lift raises it 0.2 m in 1 s and holds it 5 s. The box
+// rises with the hand and slips less than 5 mm relative to it.
+TEST(ArticulationTest, GripperLiftsABoxWithoutLettingItSlip) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(1.0, 0.0));
+  BoxSpec spec;
+  spec.size = Vec3(0.05, 0.05, 0.05);
+  spec.mass = 0.2;
+  spec.world_from_body = Translation(0, 0, 0.025);
+  spec.material = MakeMaterial(1.0, 0.0);
+  const BodyId box = AddBox(&world, spec);
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.world_from_base = Translation(0, 0, 0.1);
+  def.links = {Anchor(), BoxLink(1.0, Vec3(0.1, 0.2, 0.02), 1.0),
+               BoxLink(0.1, Vec3(0.04, 0.01, 0.06), 1.0),
+               BoxLink(0.1, Vec3(0.04, 0.01, 0.06), 1.0)};
+  // The lift slides along z; each finger hangs 0.06 m below the carriage and
+  // closes toward y = 0 along its axis.
+  def.joints = {Slider("lift", 0, 1, Vec3::Zero(), Vec3::UnitZ()),
+                Slider("left", 1, 2, Vec3(0, 0.032, -0.06), -Vec3::UnitY()),
+                Slider("right", 1, 3, Vec3(0, -0.032, -0.06), Vec3::UnitY())};
+  const ArticulationId hand = world.CreateArticulation(def).value();
+  JointCommand hold_lift;
+  hold_lift.mode = JointCommandMode::kPosition;
+  ASSERT_TRUE(world.SetJointCommand(hand, 0, hold_lift).ok());
+  JointCommand squeeze;
+  squeeze.mode = JointCommandMode::kEffort;
+  squeeze.effort = 20.0;
+  ASSERT_TRUE(world.SetJointCommand(hand, 1, squeeze).ok());
+  ASSERT_TRUE(world.SetJointCommand(hand, 2, squeeze).ok());
+  for (int step = 0; step < 120; ++step) world.Step();
+  const int lift_steps = 240;
+  for (int step = 1; step <= lift_steps; ++step) {
+    hold_lift.position = 0.2 * step / lift_steps;
+    hold_lift.velocity = 0.2;
+    ASSERT_TRUE(world.SetJointCommand(hand, 0, hold_lift).ok());
+    world.Step();
+  }
+  hold_lift.velocity = 0.0;
+  ASSERT_TRUE(world.SetJointCommand(hand, 0, hold_lift).ok());
+  const BodyId carriage = world.ArticulationLinks(hand)[1];
+  const double start_offset =
+      world.GetPose(box).translation.z() - world.GetPose(carriage).translation.z();
+  for (int step = 0; step < 5 * 240; ++step) world.Step();
+  const double end_offset =
+      world.GetPose(box).translation.z() - world.GetPose(carriage).translation.z();
+  EXPECT_NEAR(world.GetPose(box).translation.z(), 0.025 + 0.2, 5e-3);
+  EXPECT_LT(std::abs(end_offset - start_offset), 5e-3);
+}
+
+// A mimic joint follows m q_leader + offset exactly, also when it comes
+// before its leader: here two horizontal slides, the first mimicking the
+// second (m = -1, offset 0.01 m), the second driven at 0.1 m/s.
+TEST(ArticulationTest, MimicJointFollowsItsLeaderWhicheverComesFirst) {
+  World world = MakeWorld();
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Anchor(), Anchor()};
+  JointDef mimic = Slider("mimic", 0, 1, Vec3::Zero(), Vec3::UnitX());
+  mimic.mimic_joint = 1;
+  mimic.mimic_multiplier = -1.0;
+  mimic.mimic_offset = 0.01;
+  def.joints = {mimic, Slider("leader", 0, 2, Vec3(0, 1, 0), Vec3::UnitX())};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  JointCommand drive;
+  drive.mode = JointCommandMode::kVelocity;
+  drive.velocity = 0.1;
+  ASSERT_TRUE(world.SetJointCommand(id, 1, drive).ok());
+  EXPECT_FALSE(world.SetJointCommand(id, 0, drive).ok());  // a mimic takes no command
+  for (int step = 0; step < 240; ++step) world.Step();
+  const std::vector<JointState> states = world.GetJointStates(id);
+  EXPECT_NEAR(states[1].position, 0.1, 1e-3);
+  EXPECT_NEAR(states[0].position, -states[1].position + 0.01, 1e-12);
+  EXPECT_NEAR(states[0].velocity, -states[1].velocity, 1e-12);
+  const Vec3 link1 = world.GetPose(world.ArticulationLinks(id)[1]).translation;
+  EXPECT_NEAR(link1.x(), states[0].position, 1e-12);
+
+  // An effort on the leader is exerted by its mimic too: each 1 kg slide
+  // pushed by 5 N moves 1/2 (5 / 1) t^2 in t = 0.4 s.
+  World pushed = MakeWorld();
+  const ArticulationId pair = pushed.CreateArticulation(def).value();
+  JointCommand push;
+  push.mode = JointCommandMode::kEffort;
+  push.effort = 5.0;
+  ASSERT_TRUE(pushed.SetJointCommand(pair, 1, push).ok());
+  for (int step = 0; step < 96; ++step) pushed.Step();
+  EXPECT_NEAR(pushed.GetJointStates(pair)[1].position, 0.5 * 5.0 * 0.4 * 0.4, 1e-9);
+  EXPECT_NEAR(pushed.GetJointStates(pair)[0].effort, -5.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::physics::testing
