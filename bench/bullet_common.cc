@@ -20,8 +20,24 @@ BulletBodies::BulletBodies(const Scene& scene, const BulletSleep& sleep,
   (void)bouncing;
 
   const Vec3 normal = scene.world_from_ground.rotation * Vec3::UnitZ();
-  ground_shape_ = std::make_unique<btStaticPlaneShape>(
-      ToBullet(normal), normal.dot(scene.world_from_ground.translation));
+  if (scene.terrain.triangles.empty()) {
+    ground_shape_ = std::make_unique<btStaticPlaneShape>(
+        ToBullet(normal), normal.dot(scene.world_from_ground.translation));
+  } else {
+    // The terrain as Bullet's static triangle mesh with its quantized AABB
+    // tree (btBvhTriangleMeshShape), over copies of the scene's arrays.
+    for (const Vec3& vertex : scene.terrain.vertices) {
+      for (int k = 0; k < 3; ++k) terrain_vertices_.push_back(vertex[k]);
+    }
+    for (const Eigen::Vector3i& triangle : scene.terrain.triangles) {
+      for (int k = 0; k < 3; ++k) terrain_indices_.push_back(triangle[k]);
+    }
+    terrain_arrays_ = std::make_unique<btTriangleIndexVertexArray>(
+        static_cast<int>(scene.terrain.triangles.size()), terrain_indices_.data(),
+        static_cast<int>(3 * sizeof(int)), static_cast<int>(scene.terrain.vertices.size()),
+        terrain_vertices_.data(), static_cast<int>(3 * sizeof(btScalar)));
+    ground_shape_ = std::make_unique<btBvhTriangleMeshShape>(terrain_arrays_.get(), true);
+  }
   btRigidBody::btRigidBodyConstructionInfo ground_info(0.0, nullptr, ground_shape_.get());
   ground_info.m_friction = std::sqrt(scene.ground_material.friction);
   ground_info.m_restitution = 1.0;

@@ -106,6 +106,10 @@ class BulletBodies {
   btCollisionShape* Shape(const BenchBody& body);
 
   btDiscreteDynamicsWorld* world_;
+  // The terrain's arrays, before the shape that reads them.
+  std::vector<btScalar> terrain_vertices_;
+  std::vector<int> terrain_indices_;
+  std::unique_ptr<btTriangleIndexVertexArray> terrain_arrays_;
   std::unique_ptr<btCollisionShape> ground_shape_;
   std::unique_ptr<btRigidBody> ground_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;

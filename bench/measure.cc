@@ -115,6 +115,12 @@ void FinishRun(const Scene& scene, const Engine& engine, RunResult* result) {
       result->boxes_moved += moved.head<2>().norm() > 0.01;
     }
   }
+  if (scene.kind == SceneKind::kTerrain) {
+    for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i) {
+      const Vec3 position = engine.Position(i);
+      result->below_surface += position.z() < scene.hills.HeightAt(position.x(), position.y());
+    }
+  }
   if (scene.top_body < 0) return;
   const Vec3 top_start = scene.bodies[scene.top_body].world_from_body.translation;
   const Vec3 top_end = engine.Position(scene.top_body);
@@ -163,6 +169,14 @@ RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& setti
     }
     if (scene.kind == SceneKind::kBounce) {
       apex.Observe(engine->Position(0).z(), engine->LinearVelocity(0).z());
+    }
+    if (scene.kind == SceneKind::kTerrain) {
+      for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i) {
+        if (engine->LinearVelocity(i).norm() > 0.05) {
+          result.settle_time = (step + 1) * kTimeStep;
+          break;
+        }
+      }
     }
   }
   result.step_ms = total_ms;
@@ -255,7 +269,9 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
                                                     &RunResult::joint_separation,
                                                     &RunResult::boxes_moved,
                                                     &RunResult::driven_swept,
-                                                    &RunResult::driven_commanded};
+                                                    &RunResult::driven_commanded,
+                                                    &RunResult::settle_time,
+                                                    &RunResult::below_surface};
   std::vector<double> medians;
   for (double RunResult::*figure : kQualityFigures) {
     std::vector<double> values;

@@ -46,8 +46,12 @@ struct RunResult {
   double joint_separation = 0.0;      // m, articulations: largest over the run
   double boxes_moved = 0.0;           // arm: free bodies moved over 1 cm (a count)
   double driven_swept = 0.0;          // rad, arm: farthest the driven joint turned from its start
-  double driven_commanded = 0.0;      // rad, arm: the same of its commanded velocity
-  long peak_rss_kb = 0;               // filled in by the parent
+  double driven_commanded = 0.0;
+  // Terrain: s until no body moved faster than 0.05 m/s (the sleep
+  // threshold) any more, and the bodies whose centre ended below the surface.
+  double settle_time = 0.0;
+  double below_surface = 0.0;  // rad, arm: the same of its commanded velocity
+  long peak_rss_kb = 0;        // filled in by the parent
 };
 
 // wall ms per step of the steps with every moving body awake; 0 when none.

@@ -107,6 +107,11 @@ class OurEngine : public Engine {
     ground.world_from_body = scene.world_from_ground;
     physics::ShapeDef half_space;
     half_space.geometry = physics::HalfSpace{};
+    if (!scene.terrain.triangles.empty()) {
+      ground.world_from_body = Pose::Identity();
+      half_space.geometry =
+          physics::StaticMesh{physics::CollisionMesh::Make(scene.terrain).value()};
+    }
     half_space.material = ToMaterial(scene.ground_material);
     ground.shapes.push_back(half_space);
     world_->CreateBody(ground).value();

@@ -116,11 +116,21 @@ Options ParseOptions(int argc, char** argv) {
 // seconds: 10 s, except the two largest scenes, which --scale shortens.
 std::vector<Scene> SelectScenes(const Options& options) {
   std::vector<Scene> scenes = {
-      MakePile(100, 10.0),    MakePile(1000, 10.0),  MakePile(4000, 10.0 * options.scale),
-      MakePyramid(20, 10.0),  MakePyramid(40, 10.0), MakePyramid(90, 10.0 * options.scale),
-      MakeBounce(),           MakeIncline(20.0),     MakeIncline(25.0),
-      MakeIncline(28.0),      MakeIncline(35.0),     MakeChain(30, 10.0),
+      MakePile(100, 10.0),
+      MakePile(1000, 10.0),
+      MakePile(4000, 10.0 * options.scale),
+      MakePyramid(20, 10.0),
+      MakePyramid(40, 10.0),
+      MakePyramid(90, 10.0 * options.scale),
+      MakeBounce(),
+      MakeIncline(20.0),
+      MakeIncline(25.0),
+      MakeIncline(28.0),
+      MakeIncline(35.0),
+      MakeChain(30, 10.0),
       MakeArmPush(100, 10.0),
+      MakeTerrain(100, 100000, 10.0),
+      MakeFlatTerrain(100, 10.0),
   };
   if (!options.only.empty()) {
     scenes.erase(std::remove_if(scenes.begin(), scenes.end(),

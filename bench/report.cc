@@ -64,6 +64,11 @@ Quality SceneQuality(const Scene& scene, const RunResult& result) {
                     result.boxes_moved, result.driven_swept, result.driven_commanded,
                     result.joint_separation);
       break;
+    case SceneKind::kTerrain:
+      quality.value = result.settle_time;
+      std::snprintf(text, sizeof(text), "all at rest after %.2f s, %.0f below the surface",
+                    result.settle_time, result.below_surface);
+      break;
     default:
       quality.value = result.drift;
       std::snprintf(text, sizeof(text), "top-box drift %.4f m", result.drift);
@@ -282,6 +287,10 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
           [[fallthrough]];
         case SceneKind::kChain:
           values["joint_separation_m"] = Number(result.joint_separation);
+          break;
+        case SceneKind::kTerrain:
+          values["terrain_settle_s"] = Number(result.settle_time);
+          values["terrain_below_surface"] = Number(result.below_surface);
           break;
       }
       WriteCsvLine(values, csv);

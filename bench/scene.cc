@@ -239,4 +239,64 @@ Scene MakeArmPush(int boxes, double seconds) {
   return scene;
 }
 
+double Hills::HeightAt(double x, double y) const {
+  return amplitude * std::sin(x / wavelength) * std::cos(y / wavelength);
+}
+
+namespace {
+
+constexpr double kTerrainSize = 40.0;  // m, square, centred on the origin
+
+// The drop of the terrain scenes over `hills` (flat when the amplitude is 0).
+Scene DropBoxes(int count, const Hills& hills, double seconds) {
+  Scene scene;
+  scene.kind = SceneKind::kTerrain;
+  scene.seconds = seconds;
+  scene.hills = hills;
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count))));
+  for (int i = 0; i < count; ++i) {
+    BenchBody body;
+    body.box_size = Vec3::Ones();
+    body.material.friction = 0.5;
+    const double x = 3.0 * (i % side - 0.5 * (side - 1));
+    const double y = 3.0 * (i / side - 0.5 * (side - 1));
+    body.world_from_body.translation = Vec3(x, y, hills.HeightAt(x, y) + 1.5 + 0.01 * i);
+    body.world_from_body.rotation = Quat(Eigen::AngleAxisd(0.3 * i, Vec3::UnitZ()));
+    scene.bodies.push_back(body);
+  }
+  scene.top_body = count - 1;
+  return scene;
+}
+
+}  // namespace
+
+Scene MakeTerrain(int count, int triangles, double seconds) {
+  Scene scene = DropBoxes(count, Hills{0.5, 3.0}, seconds);
+  scene.name = "terrain_" + std::to_string(count);
+  const int cells = static_cast<int>(std::ceil(std::sqrt(0.5 * triangles)));
+  const double cell = kTerrainSize / cells;
+  const double x0 = -0.5 * kTerrainSize;
+  for (int j = 0; j <= cells; ++j) {
+    for (int i = 0; i <= cells; ++i) {
+      const double x = x0 + i * cell;
+      const double y = x0 + j * cell;
+      scene.terrain.vertices.emplace_back(x, y, scene.hills.HeightAt(x, y));
+    }
+  }
+  const auto at = [cells](int i, int j) { return j * (cells + 1) + i; };
+  for (int j = 0; j < cells; ++j) {
+    for (int i = 0; i < cells; ++i) {
+      scene.terrain.triangles.emplace_back(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      scene.terrain.triangles.emplace_back(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  }
+  return scene;
+}
+
+Scene MakeFlatTerrain(int count, double seconds) {
+  Scene scene = DropBoxes(count, Hills{0.0, 3.0}, seconds);
+  scene.name = "terrain_flat_" + std::to_string(count);
+  return scene;
+}
+
 }  // namespace rigid_body_sim::bench

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "rigid_body_sim/physics/mass_properties.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::bench {
@@ -39,6 +40,15 @@ enum class SceneKind {
   kIncline,  // distance slid along the slope against 1/2 g (sin - mu cos) t^2
   kChain,    // largest joint anchor separation over the run (it should be ~0)
   kArmPush,  // boxes the arm pushed, and how far its driven joint turned
+  kTerrain,  // time until every body is at rest, and bodies whose centre ended below the surface
+};
+
+// The hills of the terrain scenes: z = amplitude sin(x / wavelength)
+// cos(y / wavelength), m.
+struct Hills {
+  double amplitude = 0.0;
+  double wavelength = 1.0;
+  double HeightAt(double x, double y) const;
 };
 
 // A link of an articulation: a rigid body in its link frame, which the
@@ -96,6 +106,10 @@ struct Scene {
   // Articulated scenes: one articulation beside the free bodies.
   std::vector<BenchArticulation> articulations;
   int driven_joint = -1;  // arm: the joint whose swept angle is reported
+  // When it has triangles, the ground is this static mesh (world frame)
+  // instead of the half-space, sampling `hills`.
+  physics::TriangleMesh terrain;
+  Hills hills;
 };
 
 // pile_N: unit boxes (1 m, 1 kg, mu 0.5, e 0) in a square grid of
@@ -119,6 +133,14 @@ Scene MakeChain(int links, double seconds);
 // yaw motor sweeps it through 100 boxes of 0.1 m on the ground and back
 // (scene.cc); shoulder and elbow motors hold them still.
 Scene MakeArmPush(int boxes, double seconds);
+
+// terrain_N: N unit boxes (1 kg, mu 0.5) dropped from 1 m above rolling
+// hills (amplitude 0.5 m, wavelength 3 m) made of `triangles` (rounded up
+// to a square grid) over 40 x 40 m, in a square grid 3 m apart, each yawed
+// 0.3 rad more than the last. terrain_flat_N: the same drop onto the flat
+// half-space, the reference for the terrain's cost.
+Scene MakeTerrain(int count, int triangles, double seconds);
+Scene MakeFlatTerrain(int count, double seconds);
 
 }  // namespace rigid_body_sim::bench
 

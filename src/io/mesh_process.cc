@@ -37,6 +37,12 @@ constexpr std::size_t kMaxCachedHulls = 1024;
 
 std::string Quoted(const std::string& text) { return "'" + text + "'"; }
 
+// The text after "error " in a helper's refusal.
+std::string RefusalText(const std::string& reply) {
+  const std::size_t end = reply.find('\n');
+  return reply.substr(6, end == std::string::npos ? end : end - 6);
+}
+
 std::string HexFloat(double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%a", value);
@@ -186,15 +192,74 @@ std::string FormatErrorReply(const std::string& message) {
   return "error " + line + "\n";
 }
 
+std::string FormatTrianglesReply(const physics::TriangleMesh& mesh) {
+  std::string reply = "triangles " + std::to_string(mesh.vertices.size()) + " " +
+                      std::to_string(mesh.triangles.size()) + "\n";
+  for (const Vec3& vertex : mesh.vertices) {
+    reply += "v " + HexFloat(vertex.x()) + " " + HexFloat(vertex.y()) + " " + HexFloat(vertex.z()) +
+             "\n";
+  }
+  for (const Eigen::Vector3i& triangle : mesh.triangles) {
+    reply += "t " + std::to_string(triangle[0]) + " " + std::to_string(triangle[1]) + " " +
+             std::to_string(triangle[2]) + "\n";
+  }
+  return reply;
+}
+
+// Reads "triangles V T", V vertex lines of hexadecimal floats and T
+// triangle lines of indices below V; counts within CollisionMesh's limit.
+Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
+  using Out = Result<physics::TriangleMesh>;
+  const auto fail = [](const std::string& why) { return Out::Error("mesh helper reply: " + why); };
+  if (reply.rfind("error ", 0) == 0) return Out::Error(RefusalText(reply));
+  std::istringstream in(reply);
+  std::string word;
+  long vertex_count = 0;
+  long triangle_count = 0;
+  if (!(in >> word >> vertex_count >> triangle_count) || word != "triangles") {
+    return fail("no 'triangles <vertices> <triangles>' header");
+  }
+  const long most = static_cast<long>(physics::CollisionMesh::kMaxTriangles);
+  if (vertex_count < 3 || vertex_count > 3 * most || triangle_count < 1 || triangle_count > most) {
+    return fail(std::to_string(vertex_count) + " vertices and " + std::to_string(triangle_count) +
+                " triangles are outside [3, " + std::to_string(3 * most) + "] and [1, " +
+                std::to_string(most) + "]");
+  }
+  physics::TriangleMesh mesh;
+  mesh.vertices.resize(static_cast<std::size_t>(vertex_count));
+  for (Vec3& vertex : mesh.vertices) {
+    std::string coordinates[3];
+    if (!(in >> word >> coordinates[0] >> coordinates[1] >> coordinates[2]) || word != "v") {
+      return fail("a vertex line is malformed");
+    }
+    for (int k = 0; k < 3; ++k) {
+      char* end = nullptr;
+      vertex[k] = std::strtod(coordinates[k].c_str(), &end);
+      if (end == coordinates[k].c_str() || *end != '\0' || !std::isfinite(vertex[k])) {
+        return fail("vertex coordinate " + Quoted(coordinates[k]) + " is not a finite number");
+      }
+    }
+  }
+  mesh.triangles.resize(static_cast<std::size_t>(triangle_count));
+  for (Eigen::Vector3i& triangle : mesh.triangles) {
+    if (!(in >> word) || word != "t") return fail("a triangle line is malformed");
+    for (int k = 0; k < 3; ++k) {
+      long value = -1;
+      if (!(in >> value) || value < 0 || value >= vertex_count) {
+        return fail("a triangle has a vertex index outside [0, " + std::to_string(vertex_count) +
+                    ")");
+      }
+      triangle[k] = static_cast<int>(value);
+    }
+  }
+  return mesh;
+}
+
 Result<ConvexPolyhedron> ParseHullReply(const std::string& reply, int max_vertices) {
   const auto fail = [](const std::string& why) {
     return Result<ConvexPolyhedron>::Error("mesh helper reply: " + why);
   };
-  if (reply.rfind("error ", 0) == 0) {
-    const std::size_t end = reply.find('\n');
-    return Result<ConvexPolyhedron>::Error(
-        reply.substr(6, end == std::string::npos ? end : end - 6));
-  }
+  if (reply.rfind("error ", 0) == 0) return Result<ConvexPolyhedron>::Error(RefusalText(reply));
   std::istringstream in(reply);
   std::string word;
   long vertex_count = 0;
@@ -240,16 +305,51 @@ Result<ConvexPolyhedron> ParseHullReply(const std::string& reply, int max_vertic
   return physics::MakeConvexPolyhedron(vertices, faces);
 }
 
-Result<ConvexPolyhedron> LoadMeshHullOutOfProcess(const std::string& path, const Vec3& scale,
-                                                  const HullOptions& hull,
-                                                  const MeshProcessLimits& limits) {
-  if (!scale.allFinite() || (scale.array() == 0.0).any()) {
-    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) +
-                                           ": scale must be finite and non-zero on every axis");
-  }
+namespace {
+
+// The helper's reply to `arguments` about the file at `path`, or why there
+// is none: the file's own problem (checked before any process starts), the
+// helper's refusal (with the limits, since an allocation that failed at the
+// memory limit can look like a malformed file to the importer), its death,
+// or a reply past kMaxReplyBytes.
+Result<std::string> HelperReply(const std::vector<std::string>& arguments, const std::string& path,
+                                const MeshProcessLimits& limits) {
   if (Result<struct stat> file = CheckFile(path, limits.max_file_bytes); !file.ok()) {
     return file.status();
   }
+  Result<HelperRun> run = RunHelper(arguments, limits);
+  if (!run.ok()) return run.status();
+  if (run->oversized) {
+    return Result<std::string>::Error("mesh " + Quoted(path) + ": the mesh helper's reply " +
+                                      "passed " + std::to_string(kMaxReplyBytes) +
+                                      " bytes and it was killed");
+  }
+  const bool exited = WIFEXITED(run->status);
+  if (!run->timed_out && exited && run->reply.rfind("error ", 0) == 0) {
+    return Result<std::string>::Error(RefusalText(run->reply) + " (in the mesh helper, " +
+                                      DescribeLimits(limits) + ")");
+  }
+  if (run->timed_out || !exited || WEXITSTATUS(run->status) != 0) {
+    return Result<std::string>::Error("mesh " + Quoted(path) + ": the mesh helper " +
+                                      DescribeDeath(run->status, run->timed_out, limits));
+  }
+  return std::move(run->reply);
+}
+
+Status CheckScale(const std::string& path, const Vec3& scale) {
+  if (!scale.allFinite() || (scale.array() == 0.0).any()) {
+    return Status::Error("mesh " + Quoted(path) +
+                         ": scale must be finite and non-zero on every axis");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<ConvexPolyhedron> LoadMeshHullOutOfProcess(const std::string& path, const Vec3& scale,
+                                                  const HullOptions& hull,
+                                                  const MeshProcessLimits& limits) {
+  if (Status status = CheckScale(path, scale); !status.ok()) return status;
   const std::vector<std::string> arguments = {limits.helper_path,
                                               path,
                                               HexFloat(scale.x()),
@@ -260,28 +360,33 @@ Result<ConvexPolyhedron> LoadMeshHullOutOfProcess(const std::string& path, const
                                               std::to_string(limits.memory_bytes),
                                               HexFloat(limits.cpu_seconds),
                                               std::to_string(limits.max_file_bytes)};
-  Result<HelperRun> run = RunHelper(arguments, limits);
-  if (!run.ok()) return run.status();
-  if (run->oversized) {
-    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) + ": the mesh helper's reply " +
-                                           "passed " + std::to_string(kMaxReplyBytes) +
-                                           " bytes and it was killed");
-  }
-  const bool exited = WIFEXITED(run->status);
-  if (!run->timed_out && exited && run->reply.rfind("error ", 0) == 0) {
-    // The helper's own refusal. An allocation that failed at the memory
-    // limit can look like a malformed file to the importer, so the limits
-    // go with the reason.
-    return Result<ConvexPolyhedron>::Error(ParseHullReply(run->reply, hull.max_vertices).message() +
-                                           " (in the mesh helper, " + DescribeLimits(limits) + ")");
-  }
-  if (run->timed_out || !exited || WEXITSTATUS(run->status) != 0) {
-    return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) + ": the mesh helper " +
-                                           DescribeDeath(run->status, run->timed_out, limits));
-  }
-  Result<ConvexPolyhedron> parsed = ParseHullReply(run->reply, hull.max_vertices);
+  Result<std::string> reply = HelperReply(arguments, path, limits);
+  if (!reply.ok()) return reply.status();
+  Result<ConvexPolyhedron> parsed = ParseHullReply(*reply, hull.max_vertices);
   if (!parsed.ok()) {
     return Result<ConvexPolyhedron>::Error("mesh " + Quoted(path) + ": " + parsed.message());
+  }
+  return parsed;
+}
+
+Result<physics::TriangleMesh> LoadMeshTrianglesOutOfProcess(const std::string& path,
+                                                            const Vec3& scale,
+                                                            const MeshProcessLimits& limits) {
+  if (Status status = CheckScale(path, scale); !status.ok()) return status;
+  const std::vector<std::string> arguments = {limits.helper_path,
+                                              kTrianglesFlag,
+                                              path,
+                                              HexFloat(scale.x()),
+                                              HexFloat(scale.y()),
+                                              HexFloat(scale.z()),
+                                              std::to_string(limits.memory_bytes),
+                                              HexFloat(limits.cpu_seconds),
+                                              std::to_string(limits.max_file_bytes)};
+  Result<std::string> reply = HelperReply(arguments, path, limits);
+  if (!reply.ok()) return reply.status();
+  Result<physics::TriangleMesh> parsed = ParseTrianglesReply(*reply);
+  if (!parsed.ok()) {
+    return Result<physics::TriangleMesh>::Error("mesh " + Quoted(path) + ": " + parsed.message());
   }
   return parsed;
 }
@@ -317,6 +422,37 @@ Result<std::shared_ptr<const ConvexPolyhedron>> CachedMeshHull(const std::string
   if (cache.size() >= kMaxCachedHulls) cache.clear();
   cache.emplace(key, shared);
   return std::shared_ptr<const ConvexPolyhedron>(shared);
+}
+
+Result<std::shared_ptr<const physics::CollisionMesh>> CachedMeshTriangles(
+    const std::string& path, const Vec3& scale, const MeshProcessLimits& limits) {
+  using Out = Result<std::shared_ptr<const physics::CollisionMesh>>;
+  using Key =
+      std::tuple<std::string, double, double, double, std::int64_t, std::int64_t, std::int64_t>;
+  static std::mutex mutex;
+  static std::map<Key, std::shared_ptr<const physics::CollisionMesh>> cache;
+  Result<struct stat> file = CheckFile(path, limits.max_file_bytes);
+  if (!file.ok()) return file.status();
+  const Key key{path,
+                scale.x(),
+                scale.y(),
+                scale.z(),
+                static_cast<std::int64_t>(file->st_size),
+                static_cast<std::int64_t>(file->st_mtim.tv_sec),
+                static_cast<std::int64_t>(file->st_mtim.tv_nsec)};
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto found = cache.find(key);
+    if (found != cache.end()) return found->second;
+  }
+  Result<physics::TriangleMesh> triangles = LoadMeshTrianglesOutOfProcess(path, scale, limits);
+  if (!triangles.ok()) return triangles.status();
+  Out built = physics::CollisionMesh::Make(*triangles);
+  if (!built.ok()) return Out::Error("mesh " + Quoted(path) + ": " + built.message());
+  std::lock_guard<std::mutex> lock(mutex);
+  if (cache.size() >= kMaxCachedHulls) cache.clear();
+  cache.emplace(key, *built);
+  return built;
 }
 
 }  // namespace rigid_body_sim::io

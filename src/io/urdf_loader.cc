@@ -18,6 +18,7 @@
 #include <urdf_model/model.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "io/mesh_collision_modes.h"
 #include "io/urdf_checks.h"
 
 namespace rigid_body_sim::io {
@@ -174,6 +175,9 @@ class ModelBuilder {
     Result<std::map<std::string, double>> friction = ReadGazeboFriction(*robot);
     if (!friction.ok()) return friction.status();
     friction_ = std::move(friction).value();
+    Result<MeshCollisionModes> modes = ReadMeshCollisionModes(*robot);
+    if (!modes.ok()) return modes.status();
+    mesh_modes_ = std::move(modes).value();
 
     urdf::ModelInterfaceSharedPtr model;
     std::string parser_messages;
@@ -226,6 +230,7 @@ class ModelBuilder {
       body_root = body_root->child_links.front();
     }
     loaded.root_link = body_root->name;
+    static_model_ = loaded.is_static || options_.spawn_static;
 
     std::vector<MassProperties> parts_in_root;
     const Status status = AddLinks(*body_root, &loaded, &parts_in_root);
@@ -409,7 +414,8 @@ class ModelBuilder {
           "link " + Quoted(link.name) + " <collision> " +
           (collision.name.empty() ? std::to_string(i) : Quoted(collision.name));
       if (collision.geometry == nullptr) return Status::Error(where + " has no <geometry>");
-      Result<ShapeWithMass> shape = MakeShape(*collision.geometry, where);
+      const MeshCollision mode = ModeOf(mesh_modes_, link.name, collision.name);
+      Result<ShapeWithMass> shape = MakeShape(*collision.geometry, where, mode);
       if (!shape.ok()) return shape.status();
       const Pose link_from_shape = ToPose(collision.origin);
       LoadedShape loaded_shape;
@@ -448,7 +454,8 @@ class ModelBuilder {
     return Status::Ok();
   }
 
-  Result<ShapeWithMass> MakeShape(const urdf::Geometry& geometry, const std::string& where) {
+  Result<ShapeWithMass> MakeShape(const urdf::Geometry& geometry, const std::string& where,
+                                  MeshCollision mode) {
     const double density = options_.default_density;
     switch (geometry.type) {
       case urdf::Geometry::SPHERE: {
@@ -495,6 +502,16 @@ class ModelBuilder {
       case urdf::Geometry::MESH: {
         const auto& mesh = static_cast<const urdf::Mesh&>(geometry);
         const Vec3 scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+        if (mode == MeshCollision::kTriangles && !static_model_) {
+          return Result<ShapeWithMass>::Error(
+              where +
+              ": <mesh_collision> 'triangles' needs a static model (is_static, or fixed "
+              "to 'world'); a moving mesh collides as its 'hull'");
+        }
+        if (mode == MeshCollision::kTriangles ||
+            (mode == MeshCollision::kDefault && static_model_)) {
+          return MeshTriangleShape(mesh.filename, scale, where);
+        }
         Result<std::shared_ptr<const ConvexPolyhedron>> hull = MeshHull(mesh.filename, scale);
         if (!hull.ok()) return Result<ShapeWithMass>::Error(where + ": " + hull.message());
         Vec3 lower = (*hull)->vertices.front();
@@ -511,6 +528,53 @@ class ModelBuilder {
       }
     }
     return Result<ShapeWithMass>::Error(where + ": unknown geometry type");
+  }
+
+  // A static mesh that collides as its triangles. Its mass (for the link
+  // mass that GetModelProperties reports) is that of the solid it bounds
+  // when it is closed, else zero; a static model has no dynamics.
+  Result<ShapeWithMass> MeshTriangleShape(const std::string& uri, const Vec3& scale,
+                                          const std::string& where) {
+    using Out = Result<ShapeWithMass>;
+    Result<std::shared_ptr<const physics::CollisionMesh>> mesh = MeshTriangles(uri, scale);
+    if (!mesh.ok()) return Out::Error(where + ": " + mesh.message());
+    const Vec3 extent = (*mesh)->upper() - (*mesh)->lower();
+    if (!(extent.maxCoeff() <= kMaxShapeSize)) {
+      return Out::Error(where + " <mesh> triangles span " + FormatNumber(extent.maxCoeff()) +
+                        " m, above the allowed " + FormatNumber(kMaxShapeSize) + " m");
+    }
+    physics::TriangleMesh solid;
+    solid.vertices = (*mesh)->vertices();
+    for (const physics::CollisionMesh::Triangle& triangle : (*mesh)->triangles()) {
+      solid.triangles.emplace_back(triangle.vertices[0], triangle.vertices[1],
+                                   triangle.vertices[2]);
+    }
+    Result<MassProperties> mass =
+        physics::TriangleMeshMassProperties(options_.default_density, solid);
+    return ShapeWithMass{physics::StaticMesh{*mesh}, mass.ok() ? *mass : MassProperties{}};
+  }
+
+  // Triangles of a mesh file, shared by every collision element that uses
+  // the same file at the same scale.
+  Result<std::shared_ptr<const physics::CollisionMesh>> MeshTriangles(const std::string& uri,
+                                                                      const Vec3& scale) {
+    using Out = Result<std::shared_ptr<const physics::CollisionMesh>>;
+    const auto key = std::make_tuple(uri, scale.x(), scale.y(), scale.z());
+    const auto cached = triangle_meshes_.find(key);
+    if (cached != triangle_meshes_.end()) return cached->second;
+    Out built = Out::Error("");
+    if (options_.mesh_triangles_loader) {
+      const Result<std::string> path = resolver_(uri);
+      if (!path.ok()) return Out::Error("mesh " + Quoted(uri) + ": " + path.message());
+      built = options_.mesh_triangles_loader(*path, scale);
+    } else {
+      Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_, options_.max_file_bytes);
+      if (!mesh.ok()) return mesh.status();
+      built = physics::CollisionMesh::Make(*mesh);
+      if (!built.ok()) return Out::Error("mesh " + Quoted(uri) + ": " + built.message());
+    }
+    if (built.ok()) triangle_meshes_.emplace(key, *built);
+    return built;
   }
 
   // Hull of a mesh file, shared by every collision element that uses the
@@ -546,6 +610,11 @@ class ModelBuilder {
   const UrdfLoadOptions& options_;
   UriResolver resolver_;
   std::map<std::string, double> friction_;
+  MeshCollisionModes mesh_modes_;
+  bool static_model_ = false;  // fixed to `world`, or spawned static
+  std::map<std::tuple<std::string, double, double, double>,
+           std::shared_ptr<const physics::CollisionMesh>>
+      triangle_meshes_;
   std::map<std::tuple<std::string, double, double, double>, std::shared_ptr<const ConvexPolyhedron>>
       hulls_;
 };

@@ -242,6 +242,15 @@ std::vector<visualization_msgs::Marker> ShapeMarkers(const std::vector<physics::
           marker.points.push_back(PointToMsg(mesh.vertices[triangle[corner]]));
         }
       }
+    } else if (const auto* mesh = std::get_if<physics::StaticMesh>(&shape.geometry)) {
+      marker.type = visualization_msgs::Marker::TRIANGLE_LIST;
+      marker.scale.x = marker.scale.y = marker.scale.z = 1.0;
+      marker.points.reserve(3 * mesh->mesh->triangles().size());
+      for (const physics::CollisionMesh::Triangle& triangle : mesh->mesh->triangles()) {
+        for (const int vertex : triangle.vertices) {
+          marker.points.push_back(PointToMsg(mesh->mesh->vertices()[vertex]));
+        }
+      }
     } else {
       // The half-space z <= 0 of the shape frame, drawn as a thin slab just
       // below its surface.

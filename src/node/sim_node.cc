@@ -59,6 +59,10 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
                                                  const io::HullOptions& hull) {
     return io::CachedMeshHull(path, scale, hull, mesh_limits);
   };
+  load_options_.mesh_triangles_loader = [mesh_limits](const std::string& path,
+                                                      const physics::Vec3& scale) {
+    return io::CachedMeshTriangles(path, scale, mesh_limits);
+  };
   load_options_.resolver = ResolveRosUri;
   // Movable joints are simulated: a model with any becomes an articulation.
   load_options_.articulate = true;
@@ -199,6 +203,7 @@ void SimNode::AdvertiseServices() {
 Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
   io::UrdfLoadOptions options = load_options_;
   options.joint_positions = spec.joint_positions;
+  options.spawn_static = spec.is_static;
   if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, options);
   if (spec.urdf_path.empty()) {
     return Result<io::LoadedModel>::Error("neither urdf nor urdf_path is given");

@@ -10,18 +10,21 @@
 #include <variant>
 #include <vector>
 
+#include "physics/mesh_collision.h"
+
 namespace rigid_body_sim::physics {
 namespace {
 
 using PolyhedronPtr = std::shared_ptr<const ConvexPolyhedron>;
 
-// Variant order (Sphere, polyhedron, HalfSpace, Cylinder) is the dispatch order: the
+// Variant order (Sphere, polyhedron, HalfSpace, Cylinder, StaticMesh) is the dispatch order: the
 // pair is swapped so that A has the lower index, and the result swapped back.
 constexpr std::size_t kSphereIndex = 0;
 constexpr std::size_t kPolyhedronIndex = 1;
 constexpr std::size_t kHalfSpaceIndex = 2;
 constexpr std::size_t kCylinderIndex = 3;
-constexpr std::size_t kShapeKinds = 4;
+constexpr std::size_t kStaticMeshIndex = 4;
+constexpr std::size_t kShapeKinds = 5;
 
 // A single-point manifold.
 bool SinglePoint(const Vec3& normal_world, const Vec3& position_world, double separation,
@@ -165,6 +168,26 @@ bool CollidePolyhedronHalfSpace(const ConvexPolyhedron& polyhedron, const Pose& 
   return manifold->point_count > 0;
 }
 
+// A convex shape (A) against slot `mesh.slot` of a static mesh (B): the
+// slot's group of contacts (CollideConvexMesh). Without `stats` (the
+// time-of-impact search's and FindOverlaps' calls, which want the least
+// separation) slot 0 holds the deepest triangle contact of any group and
+// the other slots nothing (CollideConvexMeshDeepest).
+bool CollideWithMesh(const ShapeGeometry& convex, const Pose& world_from_a, const StaticMesh& mesh,
+                     const Pose& world_from_b, double contact_distance, ContactManifold* manifold,
+                     CollideStats* stats) {
+  const ConvexMeshPair pair{&convex, world_from_a, mesh.mesh.get(), world_from_b, contact_distance};
+  if (stats == nullptr) {
+    double gap = 0.0;
+    return mesh.slot == 0 && CollideConvexMeshDeepest(pair, manifold, &gap);
+  }
+  thread_local MeshContacts contacts;
+  CollideConvexMesh(pair, &contacts);
+  *manifold = contacts.manifolds[mesh.slot];
+  stats->gap = contacts.gap;
+  return manifold->point_count > 0;
+}
+
 // The manifold of (B, A) turned into that of (A, B): the normal flips and
 // the feature roles swap.
 void SwapRoles(ContactManifold* manifold) {
@@ -242,8 +265,14 @@ bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManif
           CollideCylinders({&std::get<Cylinder>(a), world_from_a, world_from_b, contact_distance},
                            *cylinder_b, manifold);
       break;
+    case kSphereIndex* kShapeKinds + kStaticMeshIndex:
+    case kPolyhedronIndex* kShapeKinds + kStaticMeshIndex:
+    case kCylinderIndex* kShapeKinds + kStaticMeshIndex:
+      touching = CollideWithMesh(a, world_from_a, std::get<StaticMesh>(b), world_from_b,
+                                 contact_distance, manifold, stats);
+      break;
     default:
-      assert(false && "two half-spaces are both static and never collide");
+      assert(false && "half-spaces and static meshes are static and never meet each other");
       break;
   }
   if (!touching) {

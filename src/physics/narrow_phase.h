@@ -23,8 +23,9 @@ struct CollideInput {
 // contact_distance. `witness` is the per-pair cache of the separating or
 // contact-defining feature, owned by the caller (may be null; only used for
 // polyhedron pairs); `stats` (may be null) reports whether it was used.
-// Two half-spaces never collide (both are static); that pair is a
-// programmer error.
+// Two half-spaces or static meshes never collide (both are static); such a
+// pair is a programmer error. A static mesh gives the manifold of its slot;
+// called without `stats`, only its deepest contact, in slot 0.
 bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManifold* manifold,
              CollideStats* stats = nullptr);
 

@@ -39,6 +39,13 @@ Status ValidateGeometry(const ShapeGeometry& geometry) {
             return Status::Error(out.str());
           }
           return Status::Ok();
+        } else if constexpr (std::is_same_v<T, StaticMesh>) {
+          if (shape.mesh == nullptr) return Status::Error("static mesh shape has no mesh");
+          if (shape.slot != 0) {
+            return Status::Error("static mesh slot is set by the world, must be 0, got " +
+                                 std::to_string(shape.slot));
+          }
+          return Status::Ok();
         } else {
           static_assert(std::is_same_v<T, HalfSpace>, "unhandled shape geometry");
           return Status::Ok();

@@ -55,6 +55,16 @@ Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape) {
     }
     return Aabb{world_from_shape.translation - extent, world_from_shape.translation + extent};
   }
+  if (const auto* mesh = std::get_if<StaticMesh>(&geometry)) {
+    // The mesh's own box turned: centre c and half extents e give the world
+    // half extents |R| e.
+    const Vec3 center = 0.5 * (mesh->mesh->upper() + mesh->mesh->lower());
+    const Vec3 half = 0.5 * (mesh->mesh->upper() - mesh->mesh->lower());
+    const Mat3 rotation = world_from_shape.rotation.toRotationMatrix();
+    const Vec3 extent = rotation.cwiseAbs() * half;
+    const Vec3 center_world = world_from_shape * center;
+    return Aabb{center_world - extent, center_world + extent};
+  }
   const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
   assert(polyhedron != nullptr && *polyhedron != nullptr);
   return PolyhedronAabb(**polyhedron, world_from_shape);
@@ -81,6 +91,9 @@ double ShapeBoundingRadius(const ShapeGeometry& geometry, const Vec3& center_sha
   }
   if (const auto* cylinder = std::get_if<Cylinder>(&geometry)) {
     return center_shape.norm() + std::hypot(cylinder->radius, cylinder->half_length);
+  }
+  if (const auto* mesh = std::get_if<StaticMesh>(&geometry)) {
+    return mesh->mesh->BoundingRadius(center_shape);
   }
   const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
   if (polyhedron == nullptr) return std::numeric_limits<double>::infinity();

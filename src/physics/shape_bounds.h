@@ -9,12 +9,14 @@
 
 namespace rigid_body_sim::physics {
 
-// World box of a sphere or polyhedron (not a half-space, which is unbounded).
+// World box of a sphere, cylinder, polyhedron or static mesh (not a half-space,
+// which is unbounded).
 Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape);
 
 // Smallest width of the shape over all directions (m): 2r for a sphere; for a
 // polyhedron the smallest extent along a face normal, which is the minimum
-// width of a convex polyhedron.
+// width of a convex polyhedron; infinite for a half-space or static mesh, whose
+// bodies never move.
 double ShapeThickness(const ShapeGeometry& geometry);
 
 // Largest distance (m) of a point of the shape from `center_shape`.

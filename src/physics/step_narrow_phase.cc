@@ -4,6 +4,7 @@
 #include <limits>
 #include <variant>
 
+#include "physics/mesh_collision.h"
 #include "physics/narrow_phase.h"
 #include "physics/shape_bounds.h"
 #include "physics/world_impl.h"
@@ -27,6 +28,48 @@ constexpr double kMarginPerThickness = 0.25;
 void MovingBodyFirst(const std::vector<Body>& bodies, std::uint32_t* body_a,
                      std::uint32_t* body_b) {
   if (bodies[*body_a].is_static || !bodies[*body_a].awake) std::swap(*body_a, *body_b);
+}
+
+// A convex shape of body A against a static mesh shape of body B.
+struct MeshVisit {
+  ContactCache* cache = nullptr;
+  std::uint64_t step = 0;
+  const std::vector<ShapeDef>* shapes_b = nullptr;
+  std::uint32_t body_a = 0;
+  std::uint16_t shape_a = 0;
+  std::uint32_t body_b = 0;
+  int shape_b = 0;      // the mesh's own index (slot 0)
+  double travel = 0.0;  // m, Body::travel of A plus B's
+};
+
+// All slots of the pair from one pass over the mesh (CollideConvexMesh):
+// each group of contacts goes to its slot's cache entry. Slot 0's entry is
+// always kept, and holds the gap while the shapes are apart; the others
+// only while they have points.
+void CollideMeshSlots(const MeshVisit& visit, const ConvexMeshPair& pair) {
+  ShapePairContact& first =
+      visit.cache->Touch(visit.body_a, visit.shape_a, visit.body_b,
+                         static_cast<std::uint16_t>(visit.shape_b), visit.step);
+  first.contact_distance = pair.contact_distance;
+  if (first.apart_gap - (visit.travel - first.apart_travel) > pair.contact_distance) return;
+  thread_local MeshContacts contacts;
+  CollideConvexMesh(pair, &contacts);
+  for (int slot = 0; slot < StaticMesh::kContactSlots; ++slot) {
+    const ContactManifold& manifold = contacts.manifolds[slot];
+    if (slot > 0 && manifold.point_count == 0) continue;
+    const int shape = MeshSlotShape(*visit.shapes_b, visit.shape_b, slot);
+    ShapePairContact& entry = visit.cache->Touch(visit.body_a, visit.shape_a, visit.body_b,
+                                                 static_cast<std::uint16_t>(shape), visit.step);
+    entry.contact_distance = pair.contact_distance;
+    entry.manifold = manifold;
+    entry.witness = SeparatingWitness{};
+    entry.anchors.valid = false;
+    entry.reuse_error = 0.0;
+    entry.apart_gap = slot == 0 && manifold.point_count == 0
+                          ? contacts.gap
+                          : -std::numeric_limits<double>::infinity();
+    entry.apart_travel = visit.travel;
+  }
 }
 
 }  // namespace
@@ -177,6 +220,16 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double
                  .Overlaps(ShapeAabb(shape_b.geometry, world_from_b * shape_b.body_from_shape))) {
           continue;
         }
+      }
+      if (const auto* mesh = std::get_if<StaticMesh>(&shape_b.geometry)) {
+        if (mesh->slot > 0) continue;  // visited with slot 0
+        pose();
+        CollideMeshSlots(
+            {&contact_cache_, step_count_, &b.shapes, body_a, static_cast<std::uint16_t>(i), body_b,
+             static_cast<int>(k), travel},
+            {&shape_a.geometry, world_from_a * shape_a.body_from_shape, mesh->mesh.get(),
+             world_from_b * shape_b.body_from_shape, contact_distance});
+        continue;
       }
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
                                                      static_cast<std::uint16_t>(k), step_count_);

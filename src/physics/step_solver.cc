@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "physics/integrator.h"
+#include "physics/mesh_collision.h"
 #include "physics/world_impl.h"
 
 namespace rigid_body_sim::physics {
@@ -64,8 +65,9 @@ ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
   ContactReport report;
   report.body_a = BodyId{pair.body_a, bodies_[pair.body_a].generation};
   report.body_b = BodyId{pair.body_b, bodies_[pair.body_b].generation};
-  report.shape_a = pair.shape_a;
-  report.shape_b = pair.shape_b;
+  // A static mesh's slot copies report as the mesh (mesh_collision.h).
+  report.shape_a = CallerShape(bodies_[pair.body_a].shapes, pair.shape_a);
+  report.shape_b = CallerShape(bodies_[pair.body_b].shapes, pair.shape_b);
   report.position_world = contact.position_world;
   report.normal_world = pair.manifold.normal_world;
   report.depth = std::max(0.0, -contact.separation);

@@ -9,6 +9,7 @@
 #include <string>
 #include <variant>
 
+#include "physics/mesh_collision.h"
 #include "physics/shape_bounds.h"
 
 namespace rigid_body_sim::physics {
@@ -106,6 +107,11 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
       return Status::Error("shape " + std::to_string(i) +
                            ": a half-space must be the only shape of a static body");
     }
+    if (std::holds_alternative<StaticMesh>(shape.geometry) && !def.is_static) {
+      return Status::Error("shape " + std::to_string(i) +
+                           ": a static triangle mesh needs a static body (is_static); a moving "
+                           "body's mesh must be a convex hull or convex pieces");
+    }
   }
   if (def.shapes.size() > kMaxShapesPerBody) {
     return Status::Error("a body may have at most " + std::to_string(kMaxShapesPerBody) +
@@ -119,6 +125,12 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
   body.is_static = def.is_static;
   body.user_data = def.user_data;
   body.shapes = def.shapes;
+  AddMeshSlots(&body.shapes);
+  if (body.shapes.size() > kMaxShapesPerBody) {
+    return Status::Error("a body may have at most " + std::to_string(kMaxShapesPerBody) +
+                         " shapes, counting " + std::to_string(StaticMesh::kContactSlots) +
+                         " per static mesh, got " + std::to_string(body.shapes.size()));
+  }
   if (!def.is_static) {
     if (Status status = ValidateMassProperties(def.mass_properties); !status.ok()) {
       return status;

@@ -6,6 +6,9 @@
 //
 // Usage: rigid_body_sim_mesh_helper PATH SX SY SZ MAX_VERTICES
 //        DEGENERATE_TOLERANCE MEMORY_BYTES CPU_SECONDS MAX_FILE_BYTES
+//    or: rigid_body_sim_mesh_helper --triangles PATH SX SY SZ MEMORY_BYTES
+//        CPU_SECONDS MAX_FILE_BYTES
+// (the triangles themselves, for a static mesh that collides as them).
 #include <sys/resource.h>
 
 #include <cstdio>
@@ -54,10 +57,41 @@ bool LimitSelf(rlim_t memory_bytes, double cpu_seconds) {
   return setrlimit(RLIMIT_CPU, &cpu_limit) == 0 && setrlimit(RLIMIT_CORE, &none) == 0;
 }
 
+// --triangles: the scaled triangles of the file.
+int ReplyTriangles(int argc, char** argv) {
+  using rigid_body_sim::io::FormatErrorReply;
+  if (argc != 9) return Reply(FormatErrorReply("mesh helper: expected 8 arguments"), 2);
+  const std::string path = argv[2];
+  const rigid_body_sim::physics::Vec3 scale(
+      std::strtod(argv[3], nullptr), std::strtod(argv[4], nullptr), std::strtod(argv[5], nullptr));
+  const unsigned long long memory_bytes = std::strtoull(argv[6], nullptr, 10);
+  const double cpu_seconds = std::strtod(argv[7], nullptr);
+  const unsigned long long max_file_bytes = std::strtoull(argv[8], nullptr, 10);
+  if (!LimitSelf(static_cast<rlim_t>(memory_bytes), cpu_seconds)) {
+    return Reply(FormatErrorReply("mesh helper: setrlimit failed"), 2);
+  }
+  try {
+    const auto as_is = [](const std::string& uri) -> Result<std::string> { return uri; };
+    const Result<rigid_body_sim::physics::TriangleMesh> mesh =
+        rigid_body_sim::io::LoadMesh(path, scale, as_is, max_file_bytes);
+    if (!mesh.ok()) return Reply(FormatErrorReply(mesh.message()), 1);
+    return Reply(rigid_body_sim::io::FormatTrianglesReply(*mesh), 0);
+  } catch (const std::bad_alloc&) {
+    return Reply(FormatErrorReply("mesh '" + path + "': out of memory in the mesh helper (limit " +
+                                  std::to_string(memory_bytes) + " bytes)"),
+                 1);
+  } catch (const std::exception& error) {
+    return Reply(FormatErrorReply("mesh '" + path + "': " + error.what()), 1);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using rigid_body_sim::io::FormatErrorReply;
+  if (argc > 1 && std::string(argv[1]) == rigid_body_sim::io::kTrianglesFlag) {
+    return ReplyTriangles(argc, argv);
+  }
   if (argc != 10) return Reply(FormatErrorReply("mesh helper: expected 9 arguments"), 2);
   const std::string path = argv[1];
   const rigid_body_sim::physics::Vec3 scale(

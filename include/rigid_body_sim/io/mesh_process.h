@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rigid_body_sim/io/convex_hull.h"
+#include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/types.h"
@@ -43,11 +44,30 @@ physics::Result<std::shared_ptr<const physics::ConvexPolyhedron>> CachedMeshHull
     const std::string& path, const physics::Vec3& scale, const HullOptions& hull,
     const MeshProcessLimits& limits);
 
+// The triangles of the mesh file at `path`, scaled per axis, read by the
+// helper (for static meshes that collide as their triangles); fails as
+// LoadMeshHullOutOfProcess does.
+physics::Result<physics::TriangleMesh> LoadMeshTrianglesOutOfProcess(
+    const std::string& path, const physics::Vec3& scale, const MeshProcessLimits& limits);
+
+// As above, built into a CollisionMesh (its tree made here), through a
+// process-wide cache keyed by path, scale, file size and modification time.
+// Thread-safe.
+physics::Result<std::shared_ptr<const physics::CollisionMesh>> CachedMeshTriangles(
+    const std::string& path, const physics::Vec3& scale, const MeshProcessLimits& limits);
+
+// The helper's first argument that asks for triangles instead of a hull.
+inline constexpr char kTrianglesFlag[] = "--triangles";
+
 // The helper's side, shared with it and with the fuzzer: the reply that
 // carries a hull through the pipe, and its parsing. The text holds
 // hexadecimal floats, so the parent gets the child's doubles exactly.
 std::string FormatHullReply(const physics::ConvexPolyhedron& hull);
 std::string FormatErrorReply(const std::string& message);
+std::string FormatTrianglesReply(const physics::TriangleMesh& mesh);
+// Parses a triangles reply (counts within CollisionMesh::kMaxTriangles,
+// indices in range, finite coordinates), or returns the helper's error.
+physics::Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply);
 // Parses a reply of at most `max_vertices` vertices into a polyhedron
 // (MakeConvexPolyhedron checks it is closed and convex), or returns the
 // helper's error message as the error.

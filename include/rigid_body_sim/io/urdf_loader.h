@@ -1,5 +1,6 @@
 // Rigid bodies from URDF models (urdfdom): links joined by fixed joints merge
-// into one body made of spheres and convex polyhedra.
+// into one body made of spheres, cylinders, convex polyhedra and, on static
+// models, triangle meshes.
 #ifndef RIGID_BODY_SIM_IO_URDF_LOADER_H_
 #define RIGID_BODY_SIM_IO_URDF_LOADER_H_
 
@@ -35,6 +36,13 @@ using MeshHullLoader =
     std::function<physics::Result<std::shared_ptr<const physics::ConvexPolyhedron>>(
         const std::string& path, const physics::Vec3& scale, const HullOptions& hull)>;
 
+// Reads the triangles of the mesh file at a resolved local `path`, scaled
+// per axis, into a static collision mesh; e.g. CachedMeshTriangles
+// (mesh_process.h), out of process.
+using MeshTrianglesLoader =
+    std::function<physics::Result<std::shared_ptr<const physics::CollisionMesh>>(
+        const std::string& path, const physics::Vec3& scale)>;
+
 struct UrdfLoadOptions {
   // kg/m^3: density of links without <inertial>, whose mass properties are
   // computed from their collision geometry.
@@ -47,6 +55,17 @@ struct UrdfLoadOptions {
   // When set, mesh hulls come from it; when empty, meshes are imported and
   // hulled in this process (LoadMesh, ComputeConvexHull).
   MeshHullLoader mesh_hull_loader;
+  // When set, the triangles of static meshes come from it; when empty, they
+  // are imported in this process (LoadMesh).
+  MeshTrianglesLoader mesh_triangles_loader;
+  // The caller spawns the model static whatever its URDF says (a spawn
+  // request's is_static): its meshes then keep their triangles by default,
+  // as those of a model fixed to `world` do. A <gazebo reference="LINK">
+  // <mesh_collision>hull</mesh_collision> (for the link, or inside
+  // <collision name="NAME"> for one element) asks for the convex hull
+  // instead, and `triangles` asks for the triangles, which only a static
+  // model may have.
+  bool spawn_static = false;
   // Maps package:// and file:// URIs of meshes to local paths. When empty,
   // ResolveFileUri is used, so package:// URIs are an error.
   UriResolver resolver;

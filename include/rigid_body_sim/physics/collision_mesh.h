@@ -1,0 +1,84 @@
+// Static triangle meshes for concave environments (bins, shelves, tables,
+// terrain): the triangles with their edge adjacency, in a bounding-volume
+// hierarchy built once. Triangles collide on their front side, the side
+// their counter-clockwise winding's normal points to: a closed mesh (as
+// mesh files of solids are) from outside, a terrain sheet from above. A
+// wall of one layer stops bodies coming at its front only.
+#ifndef RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
+#define RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "rigid_body_sim/physics/mass_properties.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+class CollisionMesh {
+ public:
+  // Most triangles a mesh may have (16 Mi): its tree and adjacency then take
+  // a few GB at most.
+  static constexpr std::size_t kMaxTriangles = std::size_t{1} << 24;
+
+  enum class EdgeFold : std::uint8_t { kFlat, kConvex, kConcave, kBoundary };
+
+  struct Triangle {
+    std::array<int, 3> vertices{};  // counter-clockwise seen from the side `normal` points to
+    Vec3 normal = Vec3::UnitZ();    // unit
+    // Edge k runs from vertices[k] to vertices[(k + 1) % 3]. The normal of
+    // the triangle across it, oriented as this one (this triangle's own
+    // normal for a boundary or non-manifold edge), and the edge's fold seen
+    // from the side `normal` points to.
+    std::array<Vec3, 3> neighbour_normals{};
+    std::array<EdgeFold, 3> edge_folds{};
+  };
+
+  // A node of the tree: a box and either two children (count == 0; the left
+  // child is the next node, the right child is node `first`) or a leaf of
+  // `count` triangles from `first` on.
+  struct Node {
+    Vec3 lower = Vec3::Zero();  // m, mesh frame
+    Vec3 upper = Vec3::Zero();
+    int first = 0;
+    int count = 0;
+  };
+
+  // Welds vertices at equal positions, drops triangles of zero area, finds
+  // each edge's neighbour and builds the tree. Fails with a message for a
+  // vertex that is not finite, an index out of range, no triangle of
+  // non-zero area, or more than kMaxTriangles triangles.
+  static Result<std::shared_ptr<const CollisionMesh>> Make(const TriangleMesh& mesh);
+
+  const std::vector<Vec3>& vertices() const { return vertices_; }
+  // In tree order (leaves hold consecutive triangles), not the input order.
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+  const std::vector<Node>& nodes() const { return nodes_; }
+
+  const Vec3& lower() const { return nodes_.front().lower; }
+  const Vec3& upper() const { return nodes_.front().upper; }
+  // The largest distance of a vertex from `center` (m).
+  double BoundingRadius(const Vec3& center) const;
+
+  // Appends to `out` the triangles whose boxes overlap the closed box
+  // [lower, upper] (mesh frame), walking the tree.
+  void QueryBox(const Vec3& lower, const Vec3& upper, std::vector<int>* out) const;
+  // The same set by testing every triangle: the reference for QueryBox.
+  void BruteForceQueryBox(const Vec3& lower, const Vec3& upper, std::vector<int>* out) const;
+
+ private:
+  CollisionMesh() = default;
+  void FindNeighbours();
+  void BuildTree();
+
+  std::vector<Vec3> vertices_;
+  std::vector<Triangle> triangles_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_

@@ -1,0 +1,166 @@
+// Static meshes through the io layer: the helper's triangles are the
+// in-process ones exactly; a static model's mesh keeps its triangles, a
+// moving one's becomes its hull; <mesh_collision> picks either and is
+// checked.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <variant>
+
+#include "rigid_body_sim/io/mesh_loader.h"
+#include "rigid_body_sim/io/mesh_process.h"
+#include "rigid_body_sim/io/urdf_loader.h"
+
+namespace rigid_body_sim::io {
+namespace {
+
+using physics::Result;
+using physics::Vec3;
+
+const std::string kUrdfDir = RBS_URDF_DIR;
+
+MeshProcessLimits HelperLimits() {
+  MeshProcessLimits limits;
+  limits.helper_path = RBS_MESH_HELPER;
+  return limits;
+}
+
+Result<std::string> ResolvePackage(const std::string& uri) {
+  const std::string prefix = "package://rigid_body_sim/urdf/";
+  if (uri.rfind(prefix, 0) == 0) return kUrdfDir + "/" + uri.substr(prefix.size());
+  return ResolveFileUri(uri);
+}
+
+UrdfLoadOptions OutOfProcessOptions() {
+  UrdfLoadOptions options;
+  options.resolver = ResolvePackage;
+  const MeshProcessLimits limits = HelperLimits();
+  options.mesh_hull_loader = [limits](const std::string& path, const Vec3& scale,
+                                      const HullOptions& hull) {
+    return CachedMeshHull(path, scale, hull, limits);
+  };
+  options.mesh_triangles_loader = [limits](const std::string& path, const Vec3& scale) {
+    return CachedMeshTriangles(path, scale, limits);
+  };
+  return options;
+}
+
+std::string MeshModel(bool fixed_to_world, const std::string& gazebo) {
+  std::string xml = "<robot name='m'>";
+  if (fixed_to_world) {
+    xml +=
+        "<link name='world'/><joint name='j' type='fixed'><parent link='world'/>"
+        "<child link='base'/></joint>";
+  }
+  xml +=
+      "<link name='base'><collision name='shell'><geometry><mesh "
+      "filename='package://rigid_body_sim/urdf/meshes/bin.stl'/></geometry></collision>"
+      "<collision name='lid'><geometry><mesh "
+      "filename='package://rigid_body_sim/urdf/meshes/bin.stl' scale='1 1 0.1'/>"
+      "</geometry></collision></link>" +
+      gazebo + "</robot>";
+  return xml;
+}
+
+TEST(StaticMeshIoTest, HelperTrianglesAreTheInProcessTrianglesExactly) {
+  const std::string path = kUrdfDir + "/meshes/bin.stl";
+  const Vec3 scale(2.0, 1.0, 0.5);
+  const Result<physics::TriangleMesh> remote =
+      LoadMeshTrianglesOutOfProcess(path, scale, HelperLimits());
+  ASSERT_TRUE(remote.ok()) << remote.message();
+  const Result<physics::TriangleMesh> local = LoadMesh(path, scale);
+  ASSERT_TRUE(local.ok()) << local.message();
+  EXPECT_EQ(remote->vertices, local->vertices);
+  EXPECT_EQ(remote->triangles, local->triangles);
+  EXPECT_EQ(remote->triangles.size(), 28u);
+}
+
+TEST(StaticMeshIoTest, TrianglesReplyIsChecked) {
+  EXPECT_EQ(ParseTrianglesReply("error boom\n").message(), "boom");
+  EXPECT_FALSE(ParseTrianglesReply("triangles 3 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nt 0 1 3\n").ok());
+  EXPECT_NE(ParseTrianglesReply("triangles 3 1\nv 0 0 0\nv 1 0 nan\nv 0 1 0\nt 0 1 2\n")
+                .message()
+                .find("not a finite number"),
+            std::string::npos);
+  EXPECT_NE(ParseTrianglesReply("triangles 3 99999999999\n").message().find("outside"),
+            std::string::npos);
+  const Result<physics::TriangleMesh> good =
+      ParseTrianglesReply("triangles 3 1\nv 0x0p+0 0 0\nv 1 0 0\nv 0 1 0\nt 0 1 2\n");
+  ASSERT_TRUE(good.ok()) << good.message();
+  EXPECT_EQ(good->triangles.front(), Eigen::Vector3i(0, 1, 2));
+}
+
+TEST(StaticMeshIoTest, StaticModelsKeepTriangles) {
+  for (const bool out_of_process : {false, true}) {
+    UrdfLoadOptions options = out_of_process ? OutOfProcessOptions() : UrdfLoadOptions();
+    options.resolver = ResolvePackage;
+    const Result<LoadedModel> fixed = LoadUrdfString(MeshModel(true, ""), options);
+    ASSERT_TRUE(fixed.ok()) << fixed.message();
+    ASSERT_EQ(fixed->shapes.size(), 2u);
+    const auto* mesh = std::get_if<physics::StaticMesh>(&fixed->shapes[0].shape.geometry);
+    ASSERT_NE(mesh, nullptr);
+    EXPECT_EQ(mesh->mesh->triangles().size(), 28u);
+    EXPECT_NEAR(mesh->mesh->upper().z(), 0.2, 1e-7);
+    // The link mass is the bins' material: outer box less the cavity, for
+    // the shell and for the lid (the shell at a tenth of its height).
+    const double shell = 0.4 * 0.3 * 0.2 - 0.39 * 0.29 * 0.195;
+    const double lid = 0.4 * 0.3 * 0.02 - 0.39 * 0.29 * 0.0195;
+    EXPECT_NEAR(fixed->links[0].mass, 1000.0 * (shell + lid), 1e-4);
+
+    options.spawn_static = true;
+    const Result<LoadedModel> spawned = LoadUrdfString(MeshModel(false, ""), options);
+    ASSERT_TRUE(spawned.ok()) << spawned.message();
+    EXPECT_TRUE(std::holds_alternative<physics::StaticMesh>(spawned->shapes[1].shape.geometry));
+  }
+}
+
+TEST(StaticMeshIoTest, MeshCollisionPicksTrianglesOrHull) {
+  UrdfLoadOptions options = OutOfProcessOptions();
+  const Result<LoadedModel> moving = LoadUrdfString(MeshModel(false, ""), options);
+  ASSERT_TRUE(moving.ok()) << moving.message();
+  EXPECT_TRUE(std::holds_alternative<std::shared_ptr<const physics::ConvexPolyhedron>>(
+      moving->shapes[0].shape.geometry));
+
+  // A static model's link asks for hulls, one collision back for triangles.
+  const std::string gazebo =
+      "<gazebo reference='base'><mesh_collision> hull </mesh_collision>"
+      "<collision name='lid'><mesh_collision>triangles</mesh_collision></collision></gazebo>";
+  const Result<LoadedModel> mixed = LoadUrdfString(MeshModel(true, gazebo), options);
+  ASSERT_TRUE(mixed.ok()) << mixed.message();
+  EXPECT_TRUE(std::holds_alternative<std::shared_ptr<const physics::ConvexPolyhedron>>(
+      mixed->shapes[0].shape.geometry));
+  EXPECT_TRUE(std::holds_alternative<physics::StaticMesh>(mixed->shapes[1].shape.geometry));
+
+  const Result<LoadedModel> refused =
+      LoadUrdfString(MeshModel(false,
+                               "<gazebo reference='base'><mesh_collision>triangles</mesh_collision>"
+                               "</gazebo>"),
+                     options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("link 'base' <collision> 'shell': <mesh_collision> "
+                                   "'triangles' needs a static model"),
+            std::string::npos)
+      << refused.message();
+
+  const Result<LoadedModel> unknown =
+      LoadUrdfString(MeshModel(true,
+                               "<gazebo reference='base'><mesh_collision>voxels</mesh_collision>"
+                               "</gazebo>"),
+                     options);
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.message().find("<gazebo reference='base'> <mesh_collision> value 'voxels' "
+                                   "is not one of 'triangles', 'hull'"),
+            std::string::npos)
+      << unknown.message();
+  const Result<LoadedModel> unnamed =
+      LoadUrdfString(MeshModel(true,
+                               "<gazebo reference='base'><collision><mesh_collision>hull"
+                               "</mesh_collision></collision></gazebo>"),
+                     options);
+  ASSERT_FALSE(unnamed.ok());
+  EXPECT_NE(unnamed.message().find("needs a name"), std::string::npos) << unnamed.message();
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::io
