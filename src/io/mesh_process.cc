@@ -206,6 +206,28 @@ std::string FormatTrianglesReply(const physics::TriangleMesh& mesh) {
   return reply;
 }
 
+namespace {
+
+// Reads one "v x y z" line of a reply into `vertex`; returns why it could
+// not ("" when it could).
+std::string ReadVertexLine(std::istream& in, Vec3* vertex) {
+  std::string word;
+  std::string coordinates[3];
+  if (!(in >> word >> coordinates[0] >> coordinates[1] >> coordinates[2]) || word != "v") {
+    return "a vertex line is malformed";
+  }
+  for (int k = 0; k < 3; ++k) {
+    char* end = nullptr;
+    (*vertex)[k] = std::strtod(coordinates[k].c_str(), &end);
+    if (end == coordinates[k].c_str() || *end != '\0' || !std::isfinite((*vertex)[k])) {
+      return "vertex coordinate " + Quoted(coordinates[k]) + " is not a finite number";
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
 // Reads "triangles V T", V vertex lines of hexadecimal floats and T
 // triangle lines of indices below V; counts within CollisionMesh's limit.
 Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
@@ -228,17 +250,7 @@ Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
   physics::TriangleMesh mesh;
   mesh.vertices.resize(static_cast<std::size_t>(vertex_count));
   for (Vec3& vertex : mesh.vertices) {
-    std::string coordinates[3];
-    if (!(in >> word >> coordinates[0] >> coordinates[1] >> coordinates[2]) || word != "v") {
-      return fail("a vertex line is malformed");
-    }
-    for (int k = 0; k < 3; ++k) {
-      char* end = nullptr;
-      vertex[k] = std::strtod(coordinates[k].c_str(), &end);
-      if (end == coordinates[k].c_str() || *end != '\0' || !std::isfinite(vertex[k])) {
-        return fail("vertex coordinate " + Quoted(coordinates[k]) + " is not a finite number");
-      }
-    }
+    if (const std::string why = ReadVertexLine(in, &vertex); !why.empty()) return fail(why);
   }
   mesh.triangles.resize(static_cast<std::size_t>(triangle_count));
   for (Eigen::Vector3i& triangle : mesh.triangles) {
@@ -275,17 +287,7 @@ Result<ConvexPolyhedron> ParseHullReply(const std::string& reply, int max_vertic
   }
   std::vector<Vec3> vertices(static_cast<std::size_t>(vertex_count));
   for (Vec3& vertex : vertices) {
-    std::string coordinates[3];
-    if (!(in >> word >> coordinates[0] >> coordinates[1] >> coordinates[2]) || word != "v") {
-      return fail("a vertex line is malformed");
-    }
-    for (int k = 0; k < 3; ++k) {
-      char* end = nullptr;
-      vertex[k] = std::strtod(coordinates[k].c_str(), &end);
-      if (end == coordinates[k].c_str() || *end != '\0' || !std::isfinite(vertex[k])) {
-        return fail("vertex coordinate " + Quoted(coordinates[k]) + " is not a finite number");
-      }
-    }
+    if (const std::string why = ReadVertexLine(in, &vertex); !why.empty()) return fail(why);
   }
   std::vector<std::vector<int>> faces(static_cast<std::size_t>(face_count));
   for (std::vector<int>& face : faces) {

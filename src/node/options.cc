@@ -251,6 +251,17 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     return Status::Error("~max_links_per_model " + std::to_string(options.max_links_per_model) +
                          " must be >= 1");
   }
+  // The servo is implicit, so any gain is stable; the bound keeps dt k
+  // (and so the soft row's terms) far from overflow.
+  constexpr double kMaxServoGain = 1e12;
+  if (!(options.servo.stiffness > 0.0 && options.servo.stiffness <= kMaxServoGain)) {
+    return Status::Error("~joint_stiffness " + FormatNumber(options.servo.stiffness) +
+                         " is outside the allowed range (0, 1e12] N m/rad");
+  }
+  if (!(options.servo.damping >= 0.0 && options.servo.damping <= kMaxServoGain)) {
+    return Status::Error("~joint_damping " + FormatNumber(options.servo.damping) +
+                         " is outside the allowed range [0, 1e12] N m s/rad");
+  }
   if (options.mesh_memory_limit < (1 << 24)) {
     return Status::Error("~mesh_memory_limit " + std::to_string(options.mesh_memory_limit) +
                          " bytes is below the allowed 16777216");
@@ -376,6 +387,8 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"max_wrench_duration", &options->limits.max_wrench_duration},
       {"max_step_count", &options->limits.max_step_count},
       {"max_links_per_model", &options->max_links_per_model},
+      {"joint_stiffness", &options->servo.stiffness},
+      {"joint_damping", &options->servo.damping},
       {"max_file_bytes", &options->max_file_bytes},
       {"mesh_memory_limit", &options->mesh_memory_limit},
       {"mesh_cpu_limit", &options->mesh_cpu_limit},

@@ -324,6 +324,8 @@ Status SimNode::CreateArticulationLocked(const physics::ArticulationDef& def,
   Result<physics::ArticulationId> id = world_.CreateArticulation(def);
   if (!id.ok()) return id.status();
   model->articulation = *id;
+  const Status gains = world_.SetServoGains(*id, options_.servo);
+  assert(gains.ok());
   model->bodies = world_.ArticulationLinks(*id);
   model->body = model->bodies.front();
   model->is_static = false;

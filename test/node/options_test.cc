@@ -26,6 +26,14 @@ TEST(OptionsTest, BadValuesAreNamed) {
   options = NodeOptions();
   options.world_frame = "/world";
   EXPECT_NE(ValidateNodeOptions(options).message().find("leading slash"), std::string::npos);
+  options = NodeOptions();
+  options.servo.stiffness = 0.0;
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~joint_stiffness 0 is outside the allowed range (0, 1e12] N m/rad");
+  options = NodeOptions();
+  options.servo.damping = -1.0;
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~joint_damping -1 is outside the allowed range [0, 1e12] N m s/rad");
 }
 
 TEST(OptionsTest, LiveRangesHoldAtStartUpAndWarnAboveAThirtiethOfASecond) {

@@ -52,6 +52,10 @@ struct NodeOptions {
   // requests beyond them are refused (request_validation.h).
   RequestLimits limits;
   int max_links_per_model = 1000;  // ~max_links_per_model: count, >= 1
+  // The position servo of joint commands (physics/articulation.h):
+  // ~joint_stiffness (N m/rad or N/m, 1e5, (0, 1e12]) and ~joint_damping
+  // (N m s/rad or N s/m, 1e3, [0, 1e12]).
+  physics::ServoGains servo;
   int max_file_bytes = 256 << 20;  // ~max_file_bytes: URDF and mesh files, bytes, >= 1
   // Limits of the mesh helper process (io/mesh_process.h).
   int mesh_memory_limit = 1 << 30;  // ~mesh_memory_limit: bytes of address space, >= 2^24
