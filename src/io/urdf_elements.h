@@ -1,0 +1,68 @@
+// The parts of a URDF document that the loader reads itself, beside
+// urdfdom, and the capture of urdfdom's messages (urdf_loader.cc).
+#ifndef RIGID_BODY_SIM_IO_URDF_ELEMENTS_H_
+#define RIGID_BODY_SIM_IO_URDF_ELEMENTS_H_
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include <console_bridge/console.h>
+#include <tinyxml.h>
+#include <urdf_model/model.h>
+
+#include "rigid_body_sim/physics/mass_properties.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::io {
+
+inline std::string Quoted(const std::string& text) { return "'" + text + "'"; }
+
+inline bool PositiveFinite(double value) { return std::isfinite(value) && value > 0.0; }
+
+// urdfdom reports why it rejects a document through console_bridge. While a
+// document is parsed, its messages are collected here so they can go into
+// the returned error instead of the process log. The output handler is
+// global, so parses are serialised.
+class ConsoleCapture : public console_bridge::OutputHandler {
+ public:
+  ConsoleCapture() : lock_(Mutex()) { console_bridge::useOutputHandler(this); }
+  ~ConsoleCapture() override { console_bridge::restorePreviousOutputHandler(); }
+  ConsoleCapture(const ConsoleCapture&) = delete;
+  ConsoleCapture& operator=(const ConsoleCapture&) = delete;
+
+  void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
+           int /*line*/) override {
+    if (level < console_bridge::CONSOLE_BRIDGE_LOG_WARN) return;
+    if (!text_.empty()) text_ += "; ";
+    text_ += text;
+  }
+  const std::string& text() const { return text_; }
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::string text_;
+};
+
+physics::Pose ToPose(const urdf::Pose& pose);
+
+const char* JointTypeName(int type);
+
+// Friction coefficients from <gazebo reference="LINK"><mu1>, which urdfdom
+// does not read, so the XML is walked directly.
+physics::Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& robot);
+
+// The link's <inertial> seen in the link frame, after checking it: mass > 0,
+// inertia finite, symmetric positive definite and obeying the triangle
+// inequality of principal moments.
+physics::Result<physics::MassProperties> InertialMassProperties(const urdf::Link& link);
+
+}  // namespace rigid_body_sim::io
+
+#endif  // RIGID_BODY_SIM_IO_URDF_ELEMENTS_H_
