@@ -105,6 +105,7 @@ def main():
     parser.add_argument('--seconds', type=float, default=3600.0)
     parser.add_argument('--warmup', type=float, default=60.0)
     parser.add_argument('--max-growth', type=float, default=0.05)
+    parser.add_argument('--report', type=float, default=300.0, help='seconds between RSS lines')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('soak', anonymous=True)
     random.seed(1)
@@ -114,11 +115,16 @@ def main():
     start = time.time()
     baseline = None
     peak = 0
+    next_report = start + args.report
     while time.time() - start < args.seconds:
         soak.round()
         if baseline is None and time.time() - start >= args.warmup:
             baseline = rss_kib(pid)
         peak = max(peak, rss_kib(pid))
+        if time.time() >= next_report:
+            next_report += args.report
+            print('soak: %.0f s, %d spawns, RSS %d KiB' % (time.time() - start, soak.counter,
+                                                          rss_kib(pid)), flush=True)
     end = rss_kib(pid)
     baseline = baseline or end
     growth = (end - baseline) / baseline
