@@ -83,6 +83,35 @@ Status CheckOrigin(const TiXmlElement& parent, const std::string& where) {
   return rpy.status();
 }
 
+// A joint's <axis xyz> finite and not the zero vector (urdfdom keeps a zero
+// axis, about which the joint could not move); its <limit> effort and
+// velocity >= 0 (0, as many descriptions write it, is no limit) and its
+// lower and upper finite; its <dynamics> damping and friction >= 0.
+Status CheckJointElements(const TiXmlElement& joint, const std::string& where) {
+  constexpr double kLargest = 1e300;
+  if (const TiXmlElement* axis = joint.FirstChildElement("axis"); axis != nullptr) {
+    const std::string at = where + " <axis>";
+    Result<std::vector<double>> xyz = NumbersIn(*axis, "xyz", at, 3, -kLargest, kLargest, false);
+    if (!xyz.ok()) return xyz.status();
+    if (!xyz->empty() && std::all_of(xyz->begin(), xyz->end(), [](double v) { return v == 0.0; })) {
+      return Status::Error(at + " xyz='0 0 0' is the zero vector; give the joint's direction");
+    }
+  }
+  const std::pair<const char*, std::pair<const char*, double>> ranges[] = {
+      {"limit", {"effort", 0.0}},      {"limit", {"velocity", 0.0}},
+      {"limit", {"lower", -kLargest}}, {"limit", {"upper", -kLargest}},
+      {"dynamics", {"damping", 0.0}},  {"dynamics", {"friction", 0.0}}};
+  for (const auto& [element_name, attribute] : ranges) {
+    const TiXmlElement* element = joint.FirstChildElement(element_name);
+    if (element == nullptr) continue;
+    Result<std::vector<double>> value =
+        NumbersIn(*element, attribute.first, where + " <" + element_name + ">", 1, attribute.second,
+                  kLargest, false);
+    if (!value.ok()) return value.status();
+  }
+  return Status::Ok();
+}
+
 Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
   for (const TiXmlElement* shape = geometry.FirstChildElement(); shape != nullptr;
        shape = shape->NextSiblingElement()) {
@@ -251,9 +280,9 @@ Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& optio
   for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
        joint = joint->NextSiblingElement("joint")) {
     const char* name = joint->Attribute("name");
-    if (Status status = CheckOrigin(*joint, "joint " + Quoted(name == nullptr ? "" : name));
-        !status.ok()) {
-      return status;
+    const std::string where = "joint " + Quoted(name == nullptr ? "" : name);
+    for (const Status& status : {CheckOrigin(*joint, where), CheckJointElements(*joint, where)}) {
+      if (!status.ok()) return status;
     }
   }
   return CheckJointTree(robot);

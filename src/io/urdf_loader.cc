@@ -225,7 +225,10 @@ class ModelBuilder {
                                  FormatNumber(position));
     }
     Vec3 axis(joint.axis.x, joint.axis.y, joint.axis.z);
-    if (!(axis.norm() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();  // URDF's default axis
+    // CheckUrdfDocument refused a zero or non-finite axis; scaled first so
+    // that an axis of 1e300 has a finite length.
+    if (!(axis.cwiseAbs().maxCoeff() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();
+    axis /= axis.cwiseAbs().maxCoeff();
     axis.normalize();
     info->axis = axis;
     if (joint.limits != nullptr) {

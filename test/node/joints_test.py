@@ -172,6 +172,44 @@ class JointsTest(unittest.TestCase):
         self.assertAlmostEqual(0.0, states.position[0], delta=1e-12)
         self.assertAlmostEqual(0.2, states.position[1], delta=1e-12)
 
+    def test_hostile_joint_values_are_refused_by_name(self):
+        """Joint values beyond the request limits (README) are refused, naming the joint,
+        the field and the value, and change nothing."""
+        request = SpawnRequest(name='arm4', friction=-1.0, restitution=-1.0,
+                               urdf_path=self.package + '/test/data/two_link_arm.urdf',
+                               joint_names=['shoulder'], joint_positions=[1e300])
+        request.pose.position.z = 1.5
+        request.pose.orientation.w = 1.0
+        response = self.spawn(request)
+        self.assertFalse(response.success)
+        for word in ("joint_positions of 'shoulder'", '1e+300', '[-10000, 10000]'):
+            self.assertIn(word, response.message)
+        self.assertFalse(self.get_state('arm4').success)
+
+        self.spawn_urdf('arm4', 'two_link_arm.urdf', 1.5, {'elbow': 0.2})
+        for bad, words in (
+                (SetJointStateRequest(model='arm4', joint_names=['elbow'], positions=[0.0],
+                                      velocities=[1e300]),
+                 ("joint 'elbow' velocity", '1e+300 rad/s', '[-10000, 10000] rad/s')),
+                (SetJointStateRequest(model='arm4', joint_names=['elbow', 'elbow'],
+                                      positions=[0.0, 0.1]),
+                 ("joint_names[1] 'elbow'", 'given twice'))):
+            response = self.set_joint_state(bad)
+            self.assertFalse(response.success)
+            for word in words:
+                self.assertIn(word, response.message)
+        self.assertAlmostEqual(0.2, self.joint_states('arm4').position[1], delta=1e-12)
+
+        # Held by position servos, then a velocity beyond ~max_angular_speed
+        # and a joint named twice: both refused whole, the servos keep holding.
+        self.command('arm4', name=['shoulder', 'elbow'], position=[0.4, -0.3])
+        self.command('arm4', name=['elbow'], velocity=[1e300])
+        self.command('arm4', name=['shoulder', 'shoulder'], position=[1.0, 1.0])
+        self.step(240)
+        states = self.joint_states('arm4')
+        self.assertAlmostEqual(0.4, states.position[0], delta=1e-4)
+        self.assertAlmostEqual(-0.3, states.position[1], delta=1e-4)
+
     def test_trajectory_reaches_its_points_on_time(self):
         self.spawn_urdf('arm3', 'two_link_arm.urdf', 1.5)
         publisher = rospy.Publisher(SIM + 'arm3/joint_trajectory', JointTrajectory, queue_size=1,
