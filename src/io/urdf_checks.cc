@@ -112,7 +112,8 @@ Status CheckJointElements(const TiXmlElement& joint, const std::string& where) {
   return Status::Ok();
 }
 
-Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
+Status CheckGeometry(const TiXmlElement& geometry, const std::string& where,
+                     double max_aspect_ratio) {
   for (const TiXmlElement* shape = geometry.FirstChildElement(); shape != nullptr;
        shape = shape->NextSiblingElement()) {
     const std::string kind = shape->ValueStr();
@@ -121,7 +122,8 @@ Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
       Result<std::vector<double>> size =
           NumbersIn(*shape, "size", at, 3, kMinShapeSize, kMaxShapeSize, true);
       if (!size.ok()) return size.status();
-      if (Status status = CheckShapeExtents(Vec3((*size)[0], (*size)[1], (*size)[2]), at);
+      if (Status status =
+              CheckShapeExtents(Vec3((*size)[0], (*size)[1], (*size)[2]), at, max_aspect_ratio);
           !status.ok()) {
         return status;
       }
@@ -133,7 +135,8 @@ Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
           NumbersIn(*shape, "length", at, 1, kMinShapeSize, kMaxShapeSize, true);
       if (!length.ok()) return length.status();
       const double diameter = 2.0 * (*radius)[0];
-      if (Status status = CheckShapeExtents(Vec3(diameter, diameter, (*length)[0]), at);
+      if (Status status =
+              CheckShapeExtents(Vec3(diameter, diameter, (*length)[0]), at, max_aspect_ratio);
           !status.ok()) {
         return status;
       }
@@ -169,7 +172,7 @@ Status CheckInertial(const TiXmlElement& inertial, const std::string& where) {
   return Status::Ok();
 }
 
-Status CheckLink(const TiXmlElement& link) {
+Status CheckLink(const TiXmlElement& link, double max_aspect_ratio) {
   const char* name = link.Attribute("name");
   const std::string where = "link " + Quoted(name == nullptr ? "" : name);
   int index = 0;
@@ -183,7 +186,9 @@ Status CheckLink(const TiXmlElement& link) {
     if (Status status = CheckOrigin(*collision, at); !status.ok()) return status;
     if (const TiXmlElement* geometry = collision->FirstChildElement("geometry");
         geometry != nullptr) {
-      if (Status status = CheckGeometry(*geometry, at); !status.ok()) return status;
+      if (Status status = CheckGeometry(*geometry, at, max_aspect_ratio); !status.ok()) {
+        return status;
+      }
     }
   }
   if (const TiXmlElement* inertial = link.FirstChildElement("inertial"); inertial != nullptr) {
@@ -194,7 +199,7 @@ Status CheckLink(const TiXmlElement& link) {
 
 }  // namespace
 
-Status CheckShapeExtents(const Vec3& extents, const std::string& what) {
+Status CheckShapeExtents(const Vec3& extents, const std::string& what, double max_aspect_ratio) {
   for (int axis = 0; axis < 3; ++axis) {
     const double size = extents[axis];
     if (!(size >= kMinShapeSize && size <= kMaxShapeSize)) {
@@ -204,10 +209,10 @@ Status CheckShapeExtents(const Vec3& extents, const std::string& what) {
     }
   }
   const double ratio = extents.maxCoeff() / extents.minCoeff();
-  if (!(ratio <= kMaxShapeAspectRatio)) {
+  if (!(ratio <= max_aspect_ratio)) {
     return Status::Error(what + ": aspect ratio " + FormatNumber(ratio) +
                          " (largest / smallest size) is above the allowed " +
-                         FormatNumber(kMaxShapeAspectRatio));
+                         FormatNumber(max_aspect_ratio));
   }
   return Status::Ok();
 }
@@ -263,7 +268,45 @@ Status CheckJointTree(const TiXmlElement& robot) {
 
 }  // namespace
 
+double MaxAspectRatio(bool static_model) {
+  return static_model ? kMaxShapeSize / kMinShapeSize : kMaxShapeAspectRatio;
+}
+
+bool EveryLinkIsMassless(const TiXmlElement& robot) {
+  bool any = false;
+  for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    if (name != nullptr && std::string(name) == "world") continue;
+    const TiXmlElement* inertial = link->FirstChildElement("inertial");
+    const TiXmlElement* mass = inertial == nullptr ? nullptr : inertial->FirstChildElement("mass");
+    double value = 1.0;
+    if (mass == nullptr || mass->QueryDoubleAttribute("value", &value) != TIXML_SUCCESS ||
+        value != 0.0) {
+      return false;
+    }
+    any = true;
+  }
+  return any;
+}
+
+bool IsStaticDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
+  if (options.spawn_static || EveryLinkIsMassless(robot)) return true;
+  for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const char* type = joint->Attribute("type");
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const char* parent_link = parent == nullptr ? nullptr : parent->Attribute("link");
+    if (type != nullptr && parent_link != nullptr && std::string(type) == "fixed" &&
+        std::string(parent_link) == "world") {
+      return true;
+    }
+  }
+  return false;
+}
+
 Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
+  const double max_aspect_ratio = MaxAspectRatio(IsStaticDocument(robot, options));
   int links = 0;
   for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
        link = link->NextSiblingElement("link")) {
@@ -275,7 +318,7 @@ Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& optio
   }
   for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
        link = link->NextSiblingElement("link")) {
-    if (Status status = CheckLink(*link); !status.ok()) return status;
+    if (Status status = CheckLink(*link, max_aspect_ratio); !status.ok()) return status;
   }
   for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
        joint = joint->NextSiblingElement("joint")) {
