@@ -18,18 +18,17 @@ using physics::JointCommandMode;
 using physics::Status;
 
 void SimNode::AdvertiseJointTopicsLocked(const Model& model) {
-  const std::string prefix = model.name + "/";
   JointTopics topics;
-  topics.states =
-      private_node_.advertise<sensor_msgs::JointState>(prefix + names::kJointStatesTopic, 10);
+  topics.handle = ros::NodeHandle(private_node_, model.name);
+  topics.states = topics.handle.advertise<sensor_msgs::JointState>(names::kJointStatesTopic, 10);
   const std::string name = model.name;
-  topics.command = private_node_.subscribe<sensor_msgs::JointState>(
-      prefix + names::kJointCommandTopic, 10,
+  topics.command = topics.handle.subscribe<sensor_msgs::JointState>(
+      names::kJointCommandTopic, 10,
       [this, name](const sensor_msgs::JointState::ConstPtr& message) {
         OnJointCommand(name, *message);
       });
-  topics.trajectory = private_node_.subscribe<trajectory_msgs::JointTrajectory>(
-      prefix + names::kJointTrajectoryTopic, 10,
+  topics.trajectory = topics.handle.subscribe<trajectory_msgs::JointTrajectory>(
+      names::kJointTrajectoryTopic, 10,
       [this, name](const trajectory_msgs::JointTrajectory::ConstPtr& message) {
         OnJointTrajectory(name, *message);
       });

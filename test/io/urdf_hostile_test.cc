@@ -152,7 +152,7 @@ TEST(UrdfHostileTest, JointAxisLimitsAndDynamicsAreChecked) {
   ExpectRefused(Hinge("<axis xyz='0 1 0'/>" + limit + "<dynamics friction='1e400'/>"),
                 {"joint 'hinge' <dynamics> friction", "not a finite number"}, options);
   const Result<LoadedModel> huge =
-      LoadUrdfString(Hinge("<axis xyz='0 3e300 0'/>" + limit), options);
+      LoadUrdfString(Hinge("<axis xyz='0 1e300 0'/>" + limit), options);
   ASSERT_TRUE(huge.ok()) << huge.message();
   ASSERT_EQ(huge->joints.size(), 1u);
   EXPECT_EQ(huge->joints[0].axis, Vec3::UnitY());
