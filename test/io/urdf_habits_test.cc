@@ -95,8 +95,8 @@ TEST(UrdfHabitsTest, TriangleInequalityMissedByRoundingIsBalanced) {
 // given, and where given when one is.
 TEST(UrdfHabitsTest, JointStartsAtZeroBroughtWithinItsLimits) {
   const std::string urdf =
-      "<robot name='arm'>" + Link("base", Inertial("1", "ixx='1' iyy='1' izz='1'")) +
-      Link("forearm", Inertial("1", "ixx='1' iyy='1' izz='1'")) +
+      "<robot name='arm'>" + Link("base", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1")) +
+      Link("forearm", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1")) +
       Hinge("base", "forearm", "<limit lower='-1.5' upper='-0.03' effort='10' velocity='1'/>") +
       "</robot>";
   UrdfLoadOptions options;

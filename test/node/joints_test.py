@@ -74,11 +74,12 @@ class JointsTest(unittest.TestCase):
         cls.set_joint_state = service('set_joint_state', SetJointState)
         cls.reset = service('reset', Trigger)
 
-    def spawn_urdf(self, name, urdf, z, joints=None):
+    def spawn_urdf(self, name, urdf, z, joints=None, x=0.0):
         request = SpawnRequest()
         request.name = name
         request.urdf_path = self.package + '/test/data/' + urdf
         request.pose = Pose()
+        request.pose.position.x = x
         request.pose.position.z = z
         request.pose.orientation.w = 1.0
         request.friction = -1.0
@@ -209,6 +210,32 @@ class JointsTest(unittest.TestCase):
         states = self.joint_states('arm4')
         self.assertAlmostEqual(0.4, states.position[0], delta=1e-4)
         self.assertAlmostEqual(-0.3, states.position[1], delta=1e-4)
+
+    def test_massless_base_and_joint_to_world_are_fixed_bases(self):
+        """Bullet's mass-0 root link, and a prismatic joint from 'world', fix the base where
+        the model is spawned; a cart on a vertical rail falls as z0 - g t^2 / 2."""
+        self.spawn_urdf('bullet_pendulum', 'massless_base_pendulum.urdf', 3.0, {'hinge': 0.5},
+                        x=-4.0)
+        self.spawn_urdf('pendulum_ref', 'pendulum.urdf', 3.0, {'hinge': 0.5}, x=4.0)
+        self.spawn_urdf('rail', 'vertical_rail.urdf', 5.0, x=8.0)
+        steps = 120
+        self.step(steps)
+        pivot = self.get_state('bullet_pendulum/pivot')
+        self.assertTrue(pivot.success, pivot.message)
+        self.assertAlmostEqual(3.0, pivot.pose.position.z, delta=1e-12)
+        self.assertAlmostEqual(-4.0, pivot.pose.position.x, delta=1e-12)
+        # It swings as pendulum.urdf does, whose base is fixed to 'world'.
+        reference = self.joint_states('pendulum_ref')
+        swung = self.joint_states('bullet_pendulum')
+        self.assertEqual(['hinge'], list(swung.name))
+        self.assertLess(swung.position[0], 0.45)
+        self.assertAlmostEqual(reference.position[0], swung.position[0], delta=1e-12)
+        self.assertAlmostEqual(reference.velocity[0], swung.velocity[0], delta=1e-12)
+        t = steps * DT
+        cart = self.get_state('rail/cart').pose.position
+        self.assertAlmostEqual(5.0 - 0.5 * G * t * t, cart.z, delta=1e-9)
+        self.assertAlmostEqual(8.0, cart.x, delta=1e-12)
+        self.assertAlmostEqual(0.0, cart.y, delta=1e-12)
 
     def test_trajectory_reaches_its_points_on_time(self):
         self.spawn_urdf('arm3', 'two_link_arm.urdf', 1.5)
