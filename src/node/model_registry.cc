@@ -87,7 +87,8 @@ Result<physics::ArticulationDef> MakeArticulationSpec(const io::LoadedModel& mod
   Result<physics::ArticulationDef> made = io::MakeArticulationDef(with_materials, warnings);
   if (!made.ok()) return made;
   physics::ArticulationDef def = std::move(made).value();
-  def.fixed_base = spec.is_static || model.is_static;
+  // MakeArticulationDef fixes a base without mass; a static spawn fixes any.
+  def.fixed_base = def.fixed_base || spec.is_static;
   def.world_from_base = spec.root_state.world_from_frame;
   def.base_linear_velocity = def.fixed_base ? Vec3::Zero() : spec.root_state.linear_velocity;
   def.base_angular_velocity = def.fixed_base ? Vec3::Zero() : spec.root_state.angular_velocity;
