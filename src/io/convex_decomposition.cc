@@ -22,6 +22,8 @@ using Index3 = Eigen::Array3i;
 // between the best plane's neighbours is tried (V-HACD's coarse-to-fine
 // plane search, Game Engine Gems 3, ch. 11).
 constexpr int kCoarsePlanes = 12;
+// Points at most in the hulls that rank candidate planes.
+constexpr std::size_t kSearchPoints = 256;
 
 // Voxels [lower, upper) per axis: a box of the grid, and the part of the
 // mesh inside it.
@@ -207,15 +209,16 @@ class Decomposer {
       const Vec3& b = mesh.vertices[triangle[1]];
       const Vec3& c = mesh.vertices[triangle[2]];
       bounds_.push_back({a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)});
+      all_triangles_.push_back(static_cast<int>(all_triangles_.size()));
     }
-    orientation_ =
-        SignedVolume(grid_.Corner(grid_.Whole().lower), grid_.Corner(grid_.Whole().upper)) < 0.0
-            ? -1.0
-            : 1.0;
+    orientation_ = SignedVolume(grid_.Corner(grid_.Whole().lower),
+                                grid_.Corner(grid_.Whole().upper), all_triangles_) < 0.0
+                       ? -1.0
+                       : 1.0;
   }
 
   std::vector<Piece> Run() {
-    std::vector<Piece> pieces = {Evaluate(grid_.Whole())};
+    std::vector<Piece> pieces = {Evaluate(grid_.Whole(), all_triangles_)};
     const double most = options_.max_concavity * volume_;
     while (static_cast<int>(pieces.size()) < options_.max_pieces) {
       int worst = -1;
@@ -247,12 +250,13 @@ class Decomposer {
   // clipped to the box's x and y range, contributes its signed xy-area times
   // that clamped height: split at z_low and z_high, the middle part by its
   // mean height, the part above by the box's height.
-  double SignedVolume(const Vec3& lower, const Vec3& upper) const {
+  double SignedVolume(const Vec3& lower, const Vec3& upper,
+                      const std::vector<int>& triangles) const {
     double volume = 0.0;
     std::vector<Vec3> polygon;
     std::vector<Vec3> scratch;
     std::vector<Vec3> middle;
-    for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
+    for (const int t : triangles) {
       const auto& [low, high] = bounds_[t];
       if ((high.head<2>().array() < lower.head<2>().array()).any() ||
           (low.head<2>().array() > upper.head<2>().array()).any() || high.z() < lower.z()) {
@@ -295,11 +299,28 @@ class Decomposer {
     }
   }
 
+  // The triangles that can matter to a cell or any cell inside it: those
+  // over its xy-rectangle that reach above its floor (the volume integral
+  // and the inside test look up the column).
+  std::vector<int> ColumnTriangles(const Cell& cell) const {
+    const Vec3 lower = grid_.Corner(cell.lower);
+    const Vec3 upper = grid_.Corner(cell.upper);
+    std::vector<int> triangles;
+    for (const int t : all_triangles_) {
+      const auto& [low, high] = bounds_[t];
+      if ((high.head<2>().array() >= lower.head<2>().array()).all() &&
+          (low.head<2>().array() <= upper.head<2>().array()).all() && high.z() >= lower.z()) {
+        triangles.push_back(t);
+      }
+    }
+    return triangles;
+  }
+
   // Vertical-ray parity, as in the voxel fill.
-  bool Inside(const Vec3& point) const {
+  bool Inside(const Vec3& point, const std::vector<int>& triangles) const {
     const Vec3 from = point + grid_.nudge();
     int crossings = 0;
-    for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
+    for (const int t : triangles) {
       const auto& [low, high] = bounds_[t];
       if (high.z() < from.z() || from.x() < low.x() || from.x() > high.x() || from.y() < low.y() ||
           from.y() > high.y()) {
@@ -315,8 +336,11 @@ class Decomposer {
 
   // The part of the mesh in a cell, its exact volume and the hull of its
   // extreme points: the mesh's triangles clipped to the cell, and the
-  // cell's corners that lie inside the mesh.
-  Piece Evaluate(const Cell& cell) const {
+  // cell's corners that lie inside the mesh. A `rough` evaluation, for the
+  // plane search, hulls at most kSearchPoints of them, evenly strided (the
+  // paper's downsampled hulls): its concavity ranks planes, the chosen cut's
+  // pieces are evaluated in full.
+  Piece Evaluate(const Cell& cell, const std::vector<int>& triangles, bool rough = false) const {
     Piece piece;
     piece.cell = cell;
     const Vec3 lower = grid_.Corner(cell.lower);
@@ -324,19 +348,39 @@ class Decomposer {
     std::vector<Vec3> points;
     std::vector<Vec3> polygon;
     std::vector<Vec3> scratch;
-    for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
+    // A vertex shared by triangles inside the cell is taken once: the hull's
+    // cost grows with its input.
+    ++stamp_;
+    for (const int t : triangles) {
       const auto& [low, high] = bounds_[t];
       if ((high.array() < lower.array()).any() || (low.array() > upper.array()).any()) continue;
+      if ((low.array() >= lower.array()).all() && (high.array() <= upper.array()).all()) {
+        for (int k = 0; k < 3; ++k) {
+          const int vertex = mesh_.triangles[t][k];
+          if (stamps_[vertex] == stamp_) continue;
+          stamps_[vertex] = stamp_;
+          points.push_back(mesh_.vertices[vertex]);
+        }
+        continue;
+      }
       ClipTriangle(t, lower, upper, 3, &polygon, &scratch);
       points.insert(points.end(), polygon.begin(), polygon.end());
     }
     for (int corner = 0; corner < 8; ++corner) {
       const Vec3 point((corner & 1) ? upper.x() : lower.x(), (corner & 2) ? upper.y() : lower.y(),
                        (corner & 4) ? upper.z() : lower.z());
-      if (Inside(point)) points.push_back(point);
+      if (Inside(point, triangles)) points.push_back(point);
     }
-    piece.volume = orientation_ * SignedVolume(lower, upper);
-    Result<ConvexPolyhedron> hull = ComputeConvexHull(points, options_.hull);
+    piece.volume = orientation_ * SignedVolume(lower, upper, triangles);
+    HullOptions hull_options = options_.hull;
+    if (rough && points.size() > kSearchPoints) {
+      const std::size_t stride = (points.size() + kSearchPoints - 1) / kSearchPoints;
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < points.size(); i += stride) points[kept++] = points[i];
+      points.resize(kept);
+    }
+    if (rough) hull_options.max_vertices = static_cast<int>(kSearchPoints);
+    Result<ConvexPolyhedron> hull = ComputeConvexHull(points, hull_options);
     if (hull.ok()) {
       piece.hull_volume = physics::PolyhedronMassProperties(1.0, *hull).mass;
       piece.hull = std::move(hull).value();
@@ -350,6 +394,7 @@ class Decomposer {
   // holding voxels; none when no plane divides the piece's voxels.
   std::optional<std::pair<Piece, Piece>> BestCut(const Piece& piece) const {
     const Cell occupied = grid_.Occupied(piece.cell);
+    const std::vector<int> triangles = ColumnTriangles(piece.cell);
     const double voxel_volume = std::pow(grid_.size(), 3);
     std::optional<std::pair<Piece, Piece>> best;
     double best_energy = std::numeric_limits<double>::infinity();
@@ -363,8 +408,8 @@ class Decomposer {
       const int left_voxels = grid_.Count(left);
       const int right_voxels = grid_.Count(right);
       if (left_voxels == 0 || right_voxels == 0) return;
-      Piece l = Evaluate(left);
-      Piece r = Evaluate(right);
+      Piece l = Evaluate(left, triangles, /*rough=*/true);
+      Piece r = Evaluate(right, triangles, /*rough=*/true);
       const double energy =
           (l.concavity + r.concavity) / volume_ +
           options_.balance_weight * voxel_volume * std::abs(left_voxels - right_voxels) / volume_;
@@ -393,7 +438,9 @@ class Decomposer {
         }
       }
     }
-    return best;
+    if (!best) return best;
+    return std::make_pair(Evaluate(best->first.cell, triangles),
+                          Evaluate(best->second.cell, triangles));
   }
 
   // The volume the hull of two pieces adds to their own hulls, and that
@@ -472,6 +519,10 @@ class Decomposer {
   double volume_;                              // m^3, the mesh's
   double orientation_ = 1.0;                   // -1 for a mesh wound inside out
   std::vector<std::pair<Vec3, Vec3>> bounds_;  // per triangle
+  std::vector<int> all_triangles_;             // 0, 1, ..., triangle count - 1
+  // Per vertex, the last Evaluate that took it.
+  mutable std::vector<long> stamps_ = std::vector<long>(mesh_.vertices.size(), 0);
+  mutable long stamp_ = 0;
 };
 
 Status CheckRange(const std::string& field, double value, double low, double high, bool open_low) {
@@ -522,7 +573,8 @@ Result<std::vector<ConvexPolyhedron>> ConvexPieces(const TriangleMesh& mesh,
     Result<physics::MassProperties> mass = physics::TriangleMeshMassProperties(1.0, mesh);
     const double hull_volume = physics::PolyhedronMassProperties(1.0, *hull).mass;
     // An open mesh bounds no volume: its hull is all there is to collide.
-    if (!mass.ok() || mass->mass >= options.convex_ratio * hull_volume) {
+    if (!mass.ok() || mass->mass >= options.convex_ratio * hull_volume ||
+        mesh.triangles.size() > kMaxAutoTriangles) {
       std::vector<ConvexPolyhedron> one;
       one.push_back(std::move(hull).value());
       return one;

@@ -3,7 +3,7 @@
 
 mug.stl: a cup around the z axis, outer radius 4 cm, inner radius 3.5 cm,
 10 cm tall with a 1 cm floor (the cavity from z = 0.01 to 0.10), circles of
-32 vertices; one watertight surface (320 triangles): outside, rim, cavity
+32 vertices; one watertight surface (256 triangles): outside, rim, cavity
 wall, cavity floor and base.
 l_bracket.stl: an L of profile (x, z) (0,0) (0.3,0) (0.3,0.05) (0.05,0.05)
 (0.05,0.3) (0,0.3) extruded over y in [0, 0.1] (20 triangles): two legs
