@@ -13,6 +13,8 @@
 #include "rigid_body_sim/io/convex_decomposition.h"
 #include "rigid_body_sim/io/mesh_loader.h"
 #include "rigid_body_sim/io/mesh_process.h"
+#include "rigid_body_sim/io/urdf_loader.h"
+#include "rigid_body_sim/physics/convex_polyhedron.h"
 
 namespace rigid_body_sim::io {
 namespace {
@@ -30,9 +32,9 @@ MeshProcessLimits HelperLimits() {
 
 // A fresh directory of this test process's own.
 std::filesystem::path TemporaryDirectory(const std::string& name) {
-  const std::filesystem::path directory =
-      std::filesystem::temp_directory_path() /
-      ("rbs_mesh_pieces_test_" + std::to_string(getpid())) / name;
+  const std::filesystem::path directory = std::filesystem::temp_directory_path() /
+                                          ("rbs_mesh_pieces_test_" + std::to_string(getpid())) /
+                                          name;
   std::filesystem::remove_all(directory);
   std::filesystem::create_directories(directory);
   return directory;
@@ -136,6 +138,78 @@ TEST(MeshPiecesTest, MalformedPiecesRepliesAreRefused) {
   const Result<ConvexPieceList> refused = ParsePiecesReply("error the mesh is open\n", 256);
   ASSERT_FALSE(refused.ok());
   EXPECT_EQ(refused.message(), "the mesh is open");
+}
+
+UrdfLoadOptions PiecesOptions() {
+  UrdfLoadOptions options;
+  const MeshProcessLimits limits = HelperLimits();
+  options.mesh_hull_loader = [limits](const std::string& path, const Vec3& scale,
+                                      const HullOptions& hull) {
+    return CachedMeshHull(path, scale, hull, limits);
+  };
+  options.mesh_pieces_loader = [limits](const std::string& path, const Vec3& scale,
+                                        const DecompositionOptions& decomposition,
+                                        PiecesRule rule) {
+    MeshPiecesRequest request;
+    request.path = path;
+    request.scale = scale;
+    request.options = decomposition;
+    request.rule = rule;
+    return CachedMeshPieces(request, limits);
+  };
+  return options;
+}
+
+std::string MeshModel(const std::string& mesh, const std::string& mode,
+                      const std::string& inertial = "") {
+  std::string xml = "<robot name='m'><link name='base'>" + inertial +
+                    "<collision name='c'><geometry><mesh filename='" + kDataDir + "/" + mesh +
+                    "'/></geometry></collision></link>";
+  if (!mode.empty()) {
+    xml += "<gazebo reference='base'><mesh_collision>" + mode + "</mesh_collision></gazebo>";
+  }
+  return xml + "</robot>";
+}
+
+// The L-bracket (test/data/make_decomposition_meshes.py): 0.1 m deep, legs
+// 0.3 m long and 0.05 m thick, volume 2.75e-3 m^3, its hull 5.875e-3 m^3
+// (ratio 0.47: decomposed by default).
+TEST(MeshPiecesTest, MovingConcaveMeshBecomesPiecesWithTheirMass) {
+  const auto pieces = LoadUrdfString(MeshModel("l_bracket.stl", ""), PiecesOptions());
+  ASSERT_TRUE(pieces.ok()) << pieces.message();
+  EXPECT_GE(pieces->shapes.size(), 2u);
+  // Mass from the pieces at 1000 kg/m^3: at least the L's, at most 1 % of
+  // it more per piece.
+  const double mass = pieces->mass_properties.mass;
+  EXPECT_GE(mass, 2.75 * (1.0 - 1e-6));
+  EXPECT_LE(mass, 2.75 * (1.0 + 0.01 * pieces->shapes.size()));
+
+  const auto hull = LoadUrdfString(MeshModel("l_bracket.stl", "hull"), PiecesOptions());
+  ASSERT_TRUE(hull.ok()) << hull.message();
+  ASSERT_EQ(hull->shapes.size(), 1u);
+  EXPECT_NEAR(hull->mass_properties.mass, 5.875, 1e-5);  // float STL coordinates
+
+  const auto inertial = LoadUrdfString(
+      MeshModel("l_bracket.stl", "decomposition",
+                "<inertial><mass value='0.5'/><inertia ixx='0.01' iyy='0.01' izz='0.01' ixy='0' "
+                "ixz='0' iyz='0'/></inertial>"),
+      PiecesOptions());
+  ASSERT_TRUE(inertial.ok()) << inertial.message();
+  EXPECT_EQ(inertial->shapes.size(), pieces->shapes.size());
+  EXPECT_EQ(inertial->mass_properties.mass, 0.5);
+}
+
+TEST(MeshPiecesTest, ConvexMovingMeshStaysOneHull) {
+  const auto model = LoadUrdfString(MeshModel("chamfered_box_binary.stl", ""), PiecesOptions());
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_EQ(model->shapes.size(), 1u);
+}
+
+TEST(MeshPiecesTest, UnknownModeIsRefusedByName) {
+  const auto model = LoadUrdfString(MeshModel("mug.stl", "pieces"), PiecesOptions());
+  ASSERT_FALSE(model.ok());
+  EXPECT_NE(model.message().find("'triangles', 'hull', 'decomposition'"), std::string::npos)
+      << model.message();
 }
 
 }  // namespace
