@@ -18,7 +18,7 @@ CMAKE_ARGS ?=
 CATKIN := catkin_make -C $(WS) -DPYTHON_EXECUTABLE=/usr/bin/python3 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_ARGS)
 
-.PHONY: demo test deps build test-sanitize test-tsan fuzz bench clean format soak
+.PHONY: demo test deps build test-sanitize sanitize test-tsan fuzz bench clean format soak
 
 # The demo scene without rviz for DEMO_SECONDS of real time, showing the
 # node's log (its status line comes every 5 s). Succeeds when the node
@@ -97,6 +97,36 @@ test-tsan: deps
 	  cat $(WS_TSAN)/tsan.*; echo "[test-tsan] ThreadSanitizer reported a race" >&2; exit 1; fi
 	@echo "[test-tsan] no ThreadSanitizer reports"
 
+# `make sanitize`: the ROS-free gtests under ASan and UBSan (test-sanitize),
+# then every node test with the node, its mesh helper and the test clients
+# built under ASan and UBSan in a workspace of their own. Python tests drive
+# the instrumented node. Any sanitizer report (a leak at exit included) fails
+# the target; the reports are in build/.ws-asan/asan.*. Allocations the
+# node's limits refuse come back as null instead of an ASan abort
+# (allocator_may_return_null), as they would without ASan.
+WS_ASAN := $(ROOT)/build/.ws-asan
+SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+SANITIZE_TARGETS := rigid_body_sim_node rigid_body_sim_mesh_helper rigid_body_sim_generate_messages \
+  rigid_body_sim_gencfg node_conversion_test \
+  node_services_test node_falling_box_test node_contacts_test node_concurrency_test \
+  node_scale_test node_hostile_test node_time_stamps_test
+sanitize: test-sanitize
+	$(MAKE) --no-print-directory ws-links WS=$(WS_ASAN)
+	catkin_make -C $(WS_ASAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -DEIGEN_NO_DEBUG -Wno-maybe-uninitialized" \
+	  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) \
+	  $(SANITIZE_TARGETS) -j$(JOBS) 2>&1 \
+	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|[Ee]rror|warning|undefined' || true)
+	rm -f $(WS_ASAN)/asan.*
+	cd $(WS_ASAN)/build && \
+	  ASAN_OPTIONS="detect_leaks=1 allocator_may_return_null=1 log_path=$(WS_ASAN)/asan" \
+	  LSAN_OPTIONS="suppressions=$(ROOT)/test/node/lsan.supp" \
+	  UBSAN_OPTIONS="print_stacktrace=1 log_path=$(WS_ASAN)/asan" \
+	  ctest --output-on-failure -R 'rostest|node_conversion'
+	@if ls $(WS_ASAN)/asan.* > /dev/null 2>&1; then \
+	  cat $(WS_ASAN)/asan.*; echo "[sanitize] a sanitizer reported an error" >&2; exit 1; fi
+	@echo "[sanitize] no AddressSanitizer or UndefinedBehaviorSanitizer reports"
+
 # libFuzzer harnesses (fuzz/) for the URDF loader, the mesh helper's parsing
 # and the node's request validation, built with clang under ASan and UBSan
 # in a plain CMake build of the ROS-free code. Each runs FUZZ_SECONDS on a
@@ -171,7 +201,7 @@ soak: build
 	  exit $$status
 
 clean:
-	rm -rf $(WS) $(WS_TSAN) $(ROOT)/build
+	rm -rf $(WS) $(WS_TSAN) $(WS_ASAN) $(ROOT)/build
 
 format:
 	clang-format -i $$(git ls-files '*.h' '*.cc')

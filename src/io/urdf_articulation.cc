@@ -95,10 +95,21 @@ Result<ArticulationDef> MakeArticulationDef(const LoadedModel& model,
     in_group.body_from_shape = group_from(shape.link_name) * shape.shape.body_from_shape;
     def.links[group_of_link.at(shape.link_name)].shapes.push_back(in_group);
   }
+  // A base without mass (Bullet's mass 0, or a movable joint to 'world')
+  // cannot float: the articulation is fixed where it is spawned.
+  def.fixed_base = model.is_static || parts[0].empty();
+  if (parts[0].empty() && !model.is_static) {
+    warnings->push_back("link '" + group_root[0] + "' and the links fixed to it have no mass; " +
+                        "the articulation's base is fixed where it is spawned");
+  }
   for (std::size_t g = 0; g < group_root.size(); ++g) {
     if (parts[g].empty()) {
-      warnings->push_back("link '" + group_root[g] + "' and the links fixed to it have no mass; " +
-                          "it moves as " + physics::FormatNumber(kPlaceholderMass) + " kg");
+      // A fixed base's mass is never used; the placeholder keeps it valid.
+      if (g != 0) {
+        warnings->push_back("link '" + group_root[g] +
+                            "' and the links fixed to it have no mass; it moves as " +
+                            physics::FormatNumber(kPlaceholderMass) + " kg");
+      }
       def.links[g].mass_properties.mass = kPlaceholderMass;
       def.links[g].mass_properties.inertia_about_com =
           physics::Mat3::Identity() * kPlaceholderInertia;
@@ -106,7 +117,6 @@ Result<ArticulationDef> MakeArticulationDef(const LoadedModel& model,
     }
     def.links[g].mass_properties = physics::CombineMassProperties(parts[g]);
   }
-  def.fixed_base = model.is_static;
   def.world_from_base = model.world_from_root;
   return def;
 }

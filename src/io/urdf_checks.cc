@@ -83,7 +83,37 @@ Status CheckOrigin(const TiXmlElement& parent, const std::string& where) {
   return rpy.status();
 }
 
-Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
+// A joint's <axis xyz> finite and not the zero vector (urdfdom keeps a zero
+// axis, about which the joint could not move); its <limit> effort and
+// velocity >= 0 (0, as many descriptions write it, is no limit) and its
+// lower and upper finite; its <dynamics> damping and friction >= 0.
+Status CheckJointElements(const TiXmlElement& joint, const std::string& where) {
+  constexpr double kLargest = 1e300;
+  if (const TiXmlElement* axis = joint.FirstChildElement("axis"); axis != nullptr) {
+    const std::string at = where + " <axis>";
+    Result<std::vector<double>> xyz = NumbersIn(*axis, "xyz", at, 3, -kLargest, kLargest, false);
+    if (!xyz.ok()) return xyz.status();
+    if (!xyz->empty() && std::all_of(xyz->begin(), xyz->end(), [](double v) { return v == 0.0; })) {
+      return Status::Error(at + " xyz='0 0 0' is the zero vector; give the joint's direction");
+    }
+  }
+  const std::pair<const char*, std::pair<const char*, double>> ranges[] = {
+      {"limit", {"effort", 0.0}},      {"limit", {"velocity", 0.0}},
+      {"limit", {"lower", -kLargest}}, {"limit", {"upper", -kLargest}},
+      {"dynamics", {"damping", 0.0}},  {"dynamics", {"friction", 0.0}}};
+  for (const auto& [element_name, attribute] : ranges) {
+    const TiXmlElement* element = joint.FirstChildElement(element_name);
+    if (element == nullptr) continue;
+    Result<std::vector<double>> value =
+        NumbersIn(*element, attribute.first, where + " <" + element_name + ">", 1, attribute.second,
+                  kLargest, false);
+    if (!value.ok()) return value.status();
+  }
+  return Status::Ok();
+}
+
+Status CheckGeometry(const TiXmlElement& geometry, const std::string& where,
+                     double max_aspect_ratio) {
   for (const TiXmlElement* shape = geometry.FirstChildElement(); shape != nullptr;
        shape = shape->NextSiblingElement()) {
     const std::string kind = shape->ValueStr();
@@ -92,7 +122,8 @@ Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
       Result<std::vector<double>> size =
           NumbersIn(*shape, "size", at, 3, kMinShapeSize, kMaxShapeSize, true);
       if (!size.ok()) return size.status();
-      if (Status status = CheckShapeExtents(Vec3((*size)[0], (*size)[1], (*size)[2]), at);
+      if (Status status =
+              CheckShapeExtents(Vec3((*size)[0], (*size)[1], (*size)[2]), at, max_aspect_ratio);
           !status.ok()) {
         return status;
       }
@@ -104,7 +135,8 @@ Status CheckGeometry(const TiXmlElement& geometry, const std::string& where) {
           NumbersIn(*shape, "length", at, 1, kMinShapeSize, kMaxShapeSize, true);
       if (!length.ok()) return length.status();
       const double diameter = 2.0 * (*radius)[0];
-      if (Status status = CheckShapeExtents(Vec3(diameter, diameter, (*length)[0]), at);
+      if (Status status =
+              CheckShapeExtents(Vec3(diameter, diameter, (*length)[0]), at, max_aspect_ratio);
           !status.ok()) {
         return status;
       }
@@ -140,7 +172,7 @@ Status CheckInertial(const TiXmlElement& inertial, const std::string& where) {
   return Status::Ok();
 }
 
-Status CheckLink(const TiXmlElement& link) {
+Status CheckLink(const TiXmlElement& link, double max_aspect_ratio) {
   const char* name = link.Attribute("name");
   const std::string where = "link " + Quoted(name == nullptr ? "" : name);
   int index = 0;
@@ -154,7 +186,9 @@ Status CheckLink(const TiXmlElement& link) {
     if (Status status = CheckOrigin(*collision, at); !status.ok()) return status;
     if (const TiXmlElement* geometry = collision->FirstChildElement("geometry");
         geometry != nullptr) {
-      if (Status status = CheckGeometry(*geometry, at); !status.ok()) return status;
+      if (Status status = CheckGeometry(*geometry, at, max_aspect_ratio); !status.ok()) {
+        return status;
+      }
     }
   }
   if (const TiXmlElement* inertial = link.FirstChildElement("inertial"); inertial != nullptr) {
@@ -165,7 +199,7 @@ Status CheckLink(const TiXmlElement& link) {
 
 }  // namespace
 
-Status CheckShapeExtents(const Vec3& extents, const std::string& what) {
+Status CheckShapeExtents(const Vec3& extents, const std::string& what, double max_aspect_ratio) {
   for (int axis = 0; axis < 3; ++axis) {
     const double size = extents[axis];
     if (!(size >= kMinShapeSize && size <= kMaxShapeSize)) {
@@ -175,10 +209,10 @@ Status CheckShapeExtents(const Vec3& extents, const std::string& what) {
     }
   }
   const double ratio = extents.maxCoeff() / extents.minCoeff();
-  if (!(ratio <= kMaxShapeAspectRatio)) {
+  if (!(ratio <= max_aspect_ratio)) {
     return Status::Error(what + ": aspect ratio " + FormatNumber(ratio) +
                          " (largest / smallest size) is above the allowed " +
-                         FormatNumber(kMaxShapeAspectRatio));
+                         FormatNumber(max_aspect_ratio));
   }
   return Status::Ok();
 }
@@ -234,7 +268,45 @@ Status CheckJointTree(const TiXmlElement& robot) {
 
 }  // namespace
 
+double MaxAspectRatio(bool static_model) {
+  return static_model ? kMaxShapeSize / kMinShapeSize : kMaxShapeAspectRatio;
+}
+
+bool EveryLinkIsMassless(const TiXmlElement& robot) {
+  bool any = false;
+  for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    if (name != nullptr && std::string(name) == "world") continue;
+    const TiXmlElement* inertial = link->FirstChildElement("inertial");
+    const TiXmlElement* mass = inertial == nullptr ? nullptr : inertial->FirstChildElement("mass");
+    double value = 1.0;
+    if (mass == nullptr || mass->QueryDoubleAttribute("value", &value) != TIXML_SUCCESS ||
+        value != 0.0) {
+      return false;
+    }
+    any = true;
+  }
+  return any;
+}
+
+bool IsStaticDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
+  if (options.spawn_static || EveryLinkIsMassless(robot)) return true;
+  for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const char* type = joint->Attribute("type");
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const char* parent_link = parent == nullptr ? nullptr : parent->Attribute("link");
+    if (type != nullptr && parent_link != nullptr && std::string(type) == "fixed" &&
+        std::string(parent_link) == "world") {
+      return true;
+    }
+  }
+  return false;
+}
+
 Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
+  const double max_aspect_ratio = MaxAspectRatio(IsStaticDocument(robot, options));
   int links = 0;
   for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
        link = link->NextSiblingElement("link")) {
@@ -246,14 +318,14 @@ Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& optio
   }
   for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
        link = link->NextSiblingElement("link")) {
-    if (Status status = CheckLink(*link); !status.ok()) return status;
+    if (Status status = CheckLink(*link, max_aspect_ratio); !status.ok()) return status;
   }
   for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
        joint = joint->NextSiblingElement("joint")) {
     const char* name = joint->Attribute("name");
-    if (Status status = CheckOrigin(*joint, "joint " + Quoted(name == nullptr ? "" : name));
-        !status.ok()) {
-      return status;
+    const std::string where = "joint " + Quoted(name == nullptr ? "" : name);
+    for (const Status& status : {CheckOrigin(*joint, where), CheckJointElements(*joint, where)}) {
+      if (!status.ok()) return status;
     }
   }
   return CheckJointTree(robot);

@@ -58,10 +58,25 @@ const char* JointTypeName(int type);
 // does not read, so the XML is walked directly.
 physics::Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& robot);
 
-// The link's <inertial> seen in the link frame, after checking it: mass > 0,
-// inertia finite, symmetric positive definite and obeying the triangle
-// inequality of principal moments.
-physics::Result<physics::MassProperties> InertialMassProperties(const urdf::Link& link);
+// A link's <inertial> as read, in the link frame, and what reading it changed.
+struct InertialReading {
+  physics::MassProperties in_link;  // mass 0: a massless link
+  std::string warning;              // empty, or what was inferred or adjusted
+};
+
+// The link's <inertial> in the link frame, checked: finite, symmetric and
+// positive definite, obeying the triangle inequality of principal moments.
+// Three habits of published descriptions are read as Bullet reads them:
+// - mass 0 is a massless link; its geometry gives it no mass either;
+// - mass > 0 with every <inertia> entry 0 takes the inertia of
+//   `geometry_in_link` (its collision geometry, uniform density) scaled to
+//   that mass, when there is geometry;
+// - principal moments that miss I1 + I2 >= I3 by at most
+//   kMaxTriangleDeficit of I3 (rounding in CAD exports) have I1 and I2
+//   scaled up until it holds.
+inline constexpr double kMaxTriangleDeficit = 0.1;
+physics::Result<InertialReading> ReadInertial(const urdf::Link& link,
+                                              const physics::MassProperties& geometry_in_link);
 
 }  // namespace rigid_body_sim::io
 

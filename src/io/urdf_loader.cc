@@ -1,5 +1,6 @@
 #include "rigid_body_sim/io/urdf_loader.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -63,6 +64,7 @@ class ModelBuilder {
       return Result<LoadedModel>::Error("URDF root element must be <robot>");
     }
     if (Status status = CheckUrdfDocument(*robot, options_); !status.ok()) return status;
+    massless_ = EveryLinkIsMassless(*robot);
     Result<std::map<std::string, double>> friction = ReadGazeboFriction(*robot);
     if (!friction.ok()) return friction.status();
     friction_ = std::move(friction).value();
@@ -105,23 +107,28 @@ class ModelBuilder {
       // A fixed joint to the world makes the model static; a floating one
       // leaves its root free.
       const int world_type = body_root->child_links.front()->parent_joint->type;
-      if (world_type != urdf::Joint::FIXED && world_type != urdf::Joint::FLOATING) {
-        return Result<LoadedModel>::Error("joint '" +
-                                          body_root->child_links.front()->parent_joint->name +
-                                          "' to link 'world' is " + JointTypeName(world_type) +
-                                          "; a joint to 'world' must be fixed or floating");
-      }
       loaded.is_static = world_type == urdf::Joint::FIXED;
-      if (!body_root->collision_array.empty() || body_root->inertial != nullptr) {
-        loaded.warnings.push_back(
-            "link 'world' stands for the fixed world; its <collision> and <inertial> are ignored");
+      // A movable joint to the world keeps 'world' as the model's root: a
+      // base without mass, which MakeArticulationDef fixes where the model
+      // is spawned.
+      if (loaded.is_static || world_type == urdf::Joint::FLOATING) {
+        if (!body_root->collision_array.empty() || body_root->inertial != nullptr) {
+          loaded.warnings.push_back(
+              "link 'world' stands for the fixed world; its <collision> and <inertial> are "
+              "ignored");
+        }
+        const urdf::Joint& world_joint = *body_root->child_links.front()->parent_joint;
+        loaded.world_from_root = ToPose(world_joint.parent_to_joint_origin_transform);
+        body_root = body_root->child_links.front();
       }
-      const urdf::Joint& world_joint = *body_root->child_links.front()->parent_joint;
-      loaded.world_from_root = ToPose(world_joint.parent_to_joint_origin_transform);
-      body_root = body_root->child_links.front();
+    }
+    if (massless_ && !loaded.is_static) {
+      loaded.is_static = true;
+      loaded.warnings.push_back("every link has mass 0: the model is static");
     }
     loaded.root_link = body_root->name;
     static_model_ = loaded.is_static || options_.spawn_static;
+    meshes_.set_max_aspect_ratio(MaxAspectRatio(static_model_));
 
     std::vector<MassProperties> parts_in_root;
     const Status status = AddLinks(*body_root, &loaded, &parts_in_root);
@@ -192,14 +199,19 @@ class ModelBuilder {
     return Status::Ok();
   }
 
-  // The position given for a joint, 0 if none; a mimic joint's follows its
-  // leader's.
+  // The position given for a joint; if none, 0 brought within the joint's
+  // limits (a published arm's elbow may have [-2.1, -0.03]). A mimic
+  // joint's follows its leader's.
   double InitialPosition(const urdf::Joint& joint) const {
     const std::string& name = joint.mimic != nullptr ? joint.mimic->joint_name : joint.name;
     const auto given = options_.joint_positions.find(name);
     const double leader = given == options_.joint_positions.end() ? 0.0 : given->second;
-    if (joint.mimic == nullptr) return leader;
-    return joint.mimic->multiplier * leader + joint.mimic->offset;
+    if (joint.mimic != nullptr) return joint.mimic->multiplier * leader + joint.mimic->offset;
+    if (given != options_.joint_positions.end() || joint.limits == nullptr ||
+        joint.type == urdf::Joint::CONTINUOUS || joint.limits->lower > joint.limits->upper) {
+      return leader;
+    }
+    return std::clamp(0.0, joint.limits->lower, joint.limits->upper);
   }
 
   static bool IsWeldable(int type) {
@@ -221,7 +233,10 @@ class ModelBuilder {
                                  FormatNumber(position));
     }
     Vec3 axis(joint.axis.x, joint.axis.y, joint.axis.z);
-    if (!(axis.norm() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();  // URDF's default axis
+    // CheckUrdfDocument refused a zero or non-finite axis; scaled first so
+    // that an axis of 1e300 has a finite length.
+    if (!(axis.cwiseAbs().maxCoeff() > 0.0) || !axis.allFinite()) axis = Vec3::UnitX();
+    axis /= axis.cwiseAbs().maxCoeff();
     axis.normalize();
     info->axis = axis;
     if (joint.limits != nullptr) {
@@ -324,16 +339,20 @@ class ModelBuilder {
           physics::TransformMassProperties(shape->mass_in_shape_frame, link_from_shape));
     }
 
+    // Overlapping collision elements count twice; a URDF that needs exact
+    // mass properties for overlapping geometry states its <inertial>.
+    const MassProperties from_geometry = physics::CombineMassProperties(geometry_parts_in_link);
     if (link.inertial != nullptr) {
-      Result<MassProperties> inertial = InertialMassProperties(link);
+      Result<InertialReading> inertial = ReadInertial(link, from_geometry);
       if (!inertial.ok()) return inertial.status();
-      loaded->links[link_index].mass = inertial->mass;
-      loaded->links[link_index].mass_in_link = *inertial;
-      parts_in_root->push_back(physics::TransformMassProperties(*inertial, root_from_link));
+      if (!inertial->warning.empty()) loaded->warnings.push_back(inertial->warning);
+      loaded->links[link_index].mass = inertial->in_link.mass;
+      loaded->links[link_index].mass_in_link = inertial->in_link;
+      if (inertial->in_link.mass > 0.0) {
+        parts_in_root->push_back(
+            physics::TransformMassProperties(inertial->in_link, root_from_link));
+      }
     } else if (!geometry_parts_in_link.empty()) {
-      // Overlapping collision elements count twice; a URDF that needs exact
-      // mass properties for overlapping geometry states its <inertial>.
-      const MassProperties from_geometry = physics::CombineMassProperties(geometry_parts_in_link);
       loaded->links[link_index].mass = from_geometry.mass;
       loaded->links[link_index].mass_in_link = from_geometry;
       parts_in_root->push_back(physics::TransformMassProperties(from_geometry, root_from_link));
@@ -368,7 +387,9 @@ class ModelBuilder {
         if (!PositiveFinite(size.x()) || !PositiveFinite(size.y()) || !PositiveFinite(size.z())) {
           return Result<ShapeWithMass>::Error(where + ": box size must be positive on every axis");
         }
-        if (Status status = CheckShapeExtents(size, where + " <box>"); !status.ok()) {
+        if (Status status =
+                CheckShapeExtents(size, where + " <box>", MaxAspectRatio(static_model_));
+            !status.ok()) {
           return status;
         }
         Result<ConvexPolyhedron> box = physics::TryMakeBoxPolyhedron(size);
@@ -383,8 +404,8 @@ class ModelBuilder {
                                               ": cylinder radius and length must be positive");
         }
         const double diameter = 2.0 * cylinder.radius;
-        if (Status status =
-                CheckShapeExtents(Vec3(diameter, diameter, cylinder.length), where + " <cylinder>");
+        if (Status status = CheckShapeExtents(Vec3(diameter, diameter, cylinder.length),
+                                              where + " <cylinder>", MaxAspectRatio(static_model_));
             !status.ok()) {
           return status;
         }
@@ -419,7 +440,8 @@ class ModelBuilder {
   UriResolver resolver_;
   std::map<std::string, double> friction_;
   MeshCollisionModes mesh_modes_;
-  bool static_model_ = false;  // fixed to `world`, or spawned static
+  bool static_model_ = false;  // fixed to `world`, massless, or spawned static
+  bool massless_ = false;      // every link states mass 0
   UrdfMeshes meshes_;
 };
 

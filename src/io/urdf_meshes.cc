@@ -16,15 +16,17 @@ using physics::Vec3;
 
 namespace {
 
-// A hull's extents within the shape limits (kMinShapeSize..kMaxShapeSize).
-Status CheckHullExtents(const ConvexPolyhedron& hull, const std::string& what) {
+// A hull's extents within the shape limits (kMinShapeSize..kMaxShapeSize,
+// and the aspect ratio).
+Status CheckHullExtents(const ConvexPolyhedron& hull, const std::string& what,
+                        double max_aspect_ratio) {
   Vec3 lower = hull.vertices.front();
   Vec3 upper = lower;
   for (const Vec3& vertex : hull.vertices) {
     lower = lower.cwiseMin(vertex);
     upper = upper.cwiseMax(vertex);
   }
-  return CheckShapeExtents(upper - lower, what);
+  return CheckShapeExtents(upper - lower, what, max_aspect_ratio);
 }
 
 }  // namespace
@@ -53,7 +55,8 @@ Result<ShapeWithMass> UrdfMeshes::Hull(const std::string& uri, const Vec3& scale
                                        const std::string& where) {
   Result<std::shared_ptr<const ConvexPolyhedron>> hull = LoadHull(uri, scale);
   if (!hull.ok()) return Result<ShapeWithMass>::Error(where + ": " + hull.message());
-  if (Status status = CheckHullExtents(**hull, where + " <mesh> hull"); !status.ok()) {
+  if (Status status = CheckHullExtents(**hull, where + " <mesh> hull", max_aspect_ratio_);
+      !status.ok()) {
     return status;
   }
   return ShapeWithMass{{*hull},
@@ -67,7 +70,8 @@ Result<ShapeWithMass> UrdfMeshes::Pieces(const std::string& uri, const Vec3& sca
   ShapeWithMass shape;
   std::vector<MassProperties> masses;
   for (const ConvexPolyhedron& piece : **pieces) {
-    if (Status status = CheckHullExtents(piece, where + " <mesh> piece"); !status.ok()) {
+    if (Status status = CheckHullExtents(piece, where + " <mesh> piece", max_aspect_ratio_);
+        !status.ok()) {
       return status;
     }
     // Aliases the list, which keeps every piece alive as long as one is used.

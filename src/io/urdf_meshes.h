@@ -30,6 +30,10 @@ class UrdfMeshes {
   UrdfMeshes(const UrdfLoadOptions& options, UriResolver resolver)
       : options_(options), resolver_(std::move(resolver)) {}
 
+  // Largest size over smallest allowed of a hull or piece (MaxAspectRatio
+  // of the model being built).
+  void set_max_aspect_ratio(double ratio) { max_aspect_ratio_ = ratio; }
+
   // A static mesh that collides as its triangles. Its mass (for the link
   // mass that GetModelProperties reports) is that of the solid it bounds
   // when it is closed, else zero; a static model has no dynamics.
@@ -54,6 +58,7 @@ class UrdfMeshes {
 
   const UrdfLoadOptions& options_;
   UriResolver resolver_;
+  double max_aspect_ratio_ = kMaxShapeAspectRatio;
   std::map<Key, std::shared_ptr<const physics::CollisionMesh>> triangle_meshes_;
   std::map<Key, std::shared_ptr<const physics::ConvexPolyhedron>> hulls_;
   std::map<std::tuple<Key, PiecesRule>,

@@ -86,6 +86,30 @@ Status ValidateModelSpec(const ModelSpec& spec, const RequestLimits& limits) {
     return Status::Error("restitution " + FormatNumber(spec.restitution) +
                          " is outside the allowed range [0, 1] (< 0: not set)");
   }
+  // The kind of each joint is known once the URDF is read; its limits are
+  // checked then. Here only the bound every kind shares.
+  for (const auto& [name, position] : spec.joint_positions) {
+    if (Status status = CheckIn(position, -kMaxJointPosition, kMaxJointPosition,
+                                "joint_positions of '" + name + "'", "(rad or m)");
+        !status.ok()) {
+      return status;
+    }
+  }
+  return Status::Ok();
+}
+
+Status ValidateJointValues(const JointValues& values, const RequestLimits& limits) {
+  const double max_speed = values.prismatic ? limits.max_linear_speed : limits.max_angular_speed;
+  const double max_effort = values.prismatic ? limits.max_force : limits.max_torque;
+  for (const Status& status :
+       {CheckIn(values.position, -kMaxJointPosition, kMaxJointPosition, values.field + " position",
+                values.prismatic ? "m" : "rad"),
+        CheckIn(values.velocity, -max_speed, max_speed, values.field + " velocity",
+                values.prismatic ? "m/s" : "rad/s"),
+        CheckIn(values.effort, -max_effort, max_effort, values.field + " effort",
+                values.prismatic ? "N" : "N m")}) {
+    if (!status.ok()) return status;
+  }
   return Status::Ok();
 }
 

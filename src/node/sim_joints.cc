@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rigid_body_sim/node/names.h"
+#include "rigid_body_sim/node/request_validation.h"
 #include "rigid_body_sim/node/sim_node.h"
 
 namespace rigid_body_sim::node {
@@ -17,18 +18,17 @@ using physics::JointCommandMode;
 using physics::Status;
 
 void SimNode::AdvertiseJointTopicsLocked(const Model& model) {
-  const std::string prefix = model.name + "/";
   JointTopics topics;
-  topics.states =
-      private_node_.advertise<sensor_msgs::JointState>(prefix + names::kJointStatesTopic, 10);
+  topics.handle = ros::NodeHandle(private_node_, model.name);
+  topics.states = topics.handle.advertise<sensor_msgs::JointState>(names::kJointStatesTopic, 10);
   const std::string name = model.name;
-  topics.command = private_node_.subscribe<sensor_msgs::JointState>(
-      prefix + names::kJointCommandTopic, 10,
+  topics.command = topics.handle.subscribe<sensor_msgs::JointState>(
+      names::kJointCommandTopic, 10,
       [this, name](const sensor_msgs::JointState::ConstPtr& message) {
         OnJointCommand(name, *message);
       });
-  topics.trajectory = private_node_.subscribe<trajectory_msgs::JointTrajectory>(
-      prefix + names::kJointTrajectoryTopic, 10,
+  topics.trajectory = topics.handle.subscribe<trajectory_msgs::JointTrajectory>(
+      names::kJointTrajectoryTopic, 10,
       [this, name](const trajectory_msgs::JointTrajectory::ConstPtr& message) {
         OnJointTrajectory(name, *message);
       });
@@ -63,13 +63,24 @@ physics::Result<int> CommandableJoint(const Model& model, const std::string& nam
   return joint;
 }
 
+// The validation's view of joint `name` of `model`, values to be filled in.
+JointValues ValuesOf(const Model& model, const std::string& name) {
+  JointValues values;
+  values.field = "joint '" + name + "'";
+  for (const io::JointInfo& info : model.joints) {
+    if (info.name == name) values.prismatic = info.type == "prismatic";
+  }
+  return values;
+}
+
 // The commands of one message, checked whole before any is applied: every
-// name a movable joint of the model that mimics none, each of position,
-// velocity and effort empty or one finite value per name. The filled field
+// name a movable joint of the model that mimics none, given once, each of
+// position, velocity and effort empty or one value per name within the
+// request limits (request_validation.h). The filled field
 // picks the mode: position (a servo, velocity its feed-forward), else
 // velocity (a motor), else effort.
 physics::Result<std::vector<std::pair<int, JointCommand>>> ParseCommand(
-    const Model& model, const sensor_msgs::JointState& message) {
+    const Model& model, const sensor_msgs::JointState& message, const RequestLimits& limits) {
   using Parsed = physics::Result<std::vector<std::pair<int, JointCommand>>>;
   const std::size_t count = message.name.size();
   const auto sized = [count](std::size_t size) { return size == 0 || size == count; };
@@ -89,6 +100,9 @@ physics::Result<std::vector<std::pair<int, JointCommand>>> ParseCommand(
     const std::string& name = message.name[i];
     const physics::Result<int> joint = CommandableJoint(model, name);
     if (!joint.ok()) return joint.status();
+    for (const auto& [earlier, unused] : commands) {
+      if (earlier == *joint) return Parsed::Error("joint '" + name + "' is named twice");
+    }
     JointCommand command;
     const auto value = [i](const std::vector<double>& values) {
       return values.empty() ? 0.0 : values[i];
@@ -96,10 +110,11 @@ physics::Result<std::vector<std::pair<int, JointCommand>>> ParseCommand(
     command.position = value(message.position);
     command.velocity = value(message.velocity);
     command.effort = value(message.effort);
-    if (!std::isfinite(command.position) || !std::isfinite(command.velocity) ||
-        !std::isfinite(command.effort)) {
-      return Parsed::Error("joint '" + name + "' has a value that is not finite");
-    }
+    JointValues values = ValuesOf(model, name);
+    values.position = command.position;
+    values.velocity = command.velocity;
+    values.effort = command.effort;
+    if (Status status = ValidateJointValues(values, limits); !status.ok()) return status;
     command.mode = !message.position.empty()   ? JointCommandMode::kPosition
                    : !message.velocity.empty() ? JointCommandMode::kVelocity
                                                : JointCommandMode::kEffort;
@@ -115,7 +130,7 @@ void SimNode::OnJointCommand(const std::string& model_name,
   std::unique_lock<std::mutex> lock = LockWorld();
   const Model* model = registry_.Find(model_name);
   if (model == nullptr || !model->articulation.IsValid()) return;
-  auto commands = ParseCommand(*model, message);
+  auto commands = ParseCommand(*model, message, options_.limits);
   if (!commands.ok()) {
     ROS_ERROR("%s/%s refused, nothing applied: %s", model_name.c_str(), names::kJointCommandTopic,
               commands.message().c_str());
@@ -155,7 +170,17 @@ void SimNode::OnJointTrajectory(const std::string& model_name,
   }
   if (active.joints.empty()) return refuse("joint_names is empty");
   std::vector<TrajectoryPoint> points;
-  for (const trajectory_msgs::JointTrajectoryPoint& point : message.points) {
+  for (std::size_t p = 0; p < message.points.size(); ++p) {
+    const trajectory_msgs::JointTrajectoryPoint& point = message.points[p];
+    for (std::size_t k = 0; k < message.joint_names.size(); ++k) {
+      JointValues values = ValuesOf(*model, message.joint_names[k]);
+      values.field = "point " + std::to_string(p) + " " + values.field;
+      values.position = k < point.positions.size() ? point.positions[k] : 0.0;
+      values.velocity = k < point.velocities.size() ? point.velocities[k] : 0.0;
+      if (Status status = ValidateJointValues(values, options_.limits); !status.ok()) {
+        return refuse(status.message());
+      }
+    }
     points.push_back(
         TrajectoryPoint{point.time_from_start.toSec(), point.positions, point.velocities});
   }
@@ -257,9 +282,19 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
         return fail("joint '" + name + "' mimics '" + info.mimic_joint + "'; set that joint");
       }
     }
+    if (std::find(request.joint_names.begin(), request.joint_names.begin() + i, name) !=
+        request.joint_names.begin() + i) {
+      return fail("joint_names[" + std::to_string(i) + "] '" + name + "' is given twice");
+    }
+    JointValues values = ValuesOf(*model, name);
+    values.position = request.positions[i];
+    values.velocity = request.velocities.empty() ? 0.0 : request.velocities[i];
+    if (Status status = ValidateJointValues(values, options_.limits); !status.ok()) {
+      return fail(status.message());
+    }
     const std::size_t joint = static_cast<std::size_t>(found - model->joint_names.begin());
-    positions[joint] = request.positions[i];
-    velocities[joint] = request.velocities.empty() ? 0.0 : request.velocities[i];
+    positions[joint] = values.position;
+    velocities[joint] = values.velocity;
   }
   const Status status = world_.SetJointStates(model->articulation, positions, velocities);
   if (!status.ok()) return fail(status.message());

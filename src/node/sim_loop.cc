@@ -153,13 +153,12 @@ void SimNode::LogStatusLocked(Clock::time_point now) {
   const double achieved = wall > 0.0 ? (world_.time() - status_sim_) / wall : 0.0;
   std::size_t static_models = 0;
   for (const auto& [name, model] : registry_.models()) static_models += model.is_static ? 1 : 0;
-  const std::size_t awake = world_.AwakeBodyCount();
-  const std::size_t dynamic = registry_.size() - static_models;
+  // Models and bodies are counted apart: a robot is one model of many bodies.
   ROS_INFO(
-      "sim time %.3f s, real-time factor %.2f%s, bodies %zu (%zu awake, %zu asleep, %zu static), "
-      "contacts %zu",
-      world_.time(), achieved, paused_ ? " (paused)" : "", registry_.size(), awake,
-      dynamic - std::min(awake, dynamic), static_models, world_.contacts().size());
+      "sim time %.3f s, real-time factor %.2f%s, models %zu (%zu static), bodies %zu "
+      "(%zu awake), contacts %zu",
+      world_.time(), achieved, paused_ ? " (paused)" : "", registry_.size(), static_models,
+      world_.BodyCount(), world_.AwakeBodyCount(), world_.contacts().size());
   status_wall_ = now;
   status_sim_ = world_.time();
 }

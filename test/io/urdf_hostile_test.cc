@@ -124,6 +124,40 @@ TEST(UrdfHostileTest, JointsThatDoNotFormATreeAreRefused) {
                 {"cycle"});
 }
 
+// A hinge between two 1 kg spheres whose <axis>, <limit> and <dynamics> are
+// `elements`.
+std::string Hinge(const std::string& elements) {
+  const std::string link_body =
+      "<inertial><mass value='1'/><inertia ixx='1' iyy='1' izz='1' ixy='0' ixz='0' iyz='0'/>"
+      "</inertial><collision><geometry><sphere radius='0.1'/></geometry></collision>";
+  return "<robot name='r'><link name='a'>" + link_body + "</link><link name='b'>" + link_body +
+         "</link><joint name='hinge' type='revolute'><parent link='a'/><child link='b'/>" +
+         elements + "</joint></robot>";
+}
+
+// urdfdom keeps a zero axis and negative limits; each is refused by name.
+// A huge but finite axis is a direction like any other.
+TEST(UrdfHostileTest, JointAxisLimitsAndDynamicsAreChecked) {
+  UrdfLoadOptions options;
+  options.articulate = true;
+  const std::string limit = "<limit lower='-1' upper='1' effort='10' velocity='2'/>";
+  ExpectRefused(Hinge("<axis xyz='0 0 0'/>" + limit),
+                {"joint 'hinge' <axis>", "xyz='0 0 0'", "zero vector"}, options);
+  ExpectRefused(Hinge("<axis xyz='0 1 0'/><limit lower='-1' upper='1' effort='-10' velocity='2'/>"),
+                {"joint 'hinge' <limit> effort", "-10", "[0, 1e+300]"}, options);
+  ExpectRefused(Hinge("<axis xyz='0 1 0'/><limit lower='-1' upper='1' effort='10' velocity='-2'/>"),
+                {"joint 'hinge' <limit> velocity", "-2", "[0, 1e+300]"}, options);
+  ExpectRefused(Hinge("<axis xyz='0 1 0'/>" + limit + "<dynamics damping='-1'/>"),
+                {"joint 'hinge' <dynamics> damping", "-1", "[0, 1e+300]"}, options);
+  ExpectRefused(Hinge("<axis xyz='0 1 0'/>" + limit + "<dynamics friction='1e400'/>"),
+                {"joint 'hinge' <dynamics> friction", "not a finite number"}, options);
+  const Result<LoadedModel> huge =
+      LoadUrdfString(Hinge("<axis xyz='0 1e300 0'/>" + limit), options);
+  ASSERT_TRUE(huge.ok()) << huge.message();
+  ASSERT_EQ(huge->joints.size(), 1u);
+  EXPECT_EQ(huge->joints[0].axis, Vec3::UnitY());
+}
+
 TEST(UrdfHostileTest, DocumentEndingInAUtf8LeadByteIsRefused) {
   const Result<LoadedModel> model =
       LoadUrdfFile(std::string(RBS_TEST_DATA_DIR) + "/utf8_lead_byte_at_end.urdf");

@@ -410,9 +410,6 @@ INSTANTIATE_TEST_SUITE_P(
                 "</geometry></collision></link><link name=\"b\"/><joint name=\"free\" "
                 "type=\"floating\"><parent link=\"a\"/><child link=\"b\"/></joint></robot>",
                 {"joint 'free' is floating"}},
-        BadCase{"zero mass",
-                OneLinkUrdf(BoxInertial("0", "ixx=\"1\" iyy=\"1\" izz=\"1\"")),
-                {"link 'part': invalid <inertial>"}},
         BadCase{"negative mass",
                 OneLinkUrdf(BoxInertial("-2", "ixx=\"1\" iyy=\"1\" izz=\"1\"")),
                 {"link 'part': invalid <inertial>"}},
@@ -563,8 +560,8 @@ TEST(UrdfLoaderTest, ArticulatedModelKeepsItsJoints) {
   EXPECT_NE(refused.message().find("joint 'slider' is planar"), std::string::npos);
 }
 
-// A floating joint to 'world' leaves the root free; a movable one is
-// refused by name.
+// A floating joint to 'world' leaves the root free; a movable one keeps
+// 'world' as a base without mass, which the articulation fixes.
 TEST(UrdfLoaderTest, JointToWorldIsFixedOrFloating) {
   const auto urdf = [](const std::string& type) {
     return "<robot name=\"r\"><link name=\"world\"/><joint name=\"to_world\" type=\"" + type +
@@ -582,10 +579,17 @@ TEST(UrdfLoaderTest, JointToWorldIsFixedOrFloating) {
   ASSERT_TRUE(model.ok()) << model.message();
   EXPECT_FALSE(model->is_static);
   model = LoadUrdfString(urdf("revolute"), options);
-  ASSERT_FALSE(model.ok());
-  EXPECT_EQ(model.message(),
-            "joint 'to_world' to link 'world' is revolute; a joint to 'world' must be fixed or "
-            "floating");
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_FALSE(model->is_static);
+  EXPECT_EQ(model->root_link, "world");
+  ASSERT_EQ(model->joints.size(), 1u);
+  EXPECT_EQ(model->joints[0].type, "revolute");
+  std::vector<std::string> warnings;
+  const Result<physics::ArticulationDef> def = MakeArticulationDef(*model, &warnings);
+  ASSERT_TRUE(def.ok()) << def.message();
+  EXPECT_TRUE(def->fixed_base);
+  ASSERT_EQ(def->links.size(), 2u);
+  EXPECT_EQ(def->links[0].name, "world");
 }
 
 }  // namespace

@@ -74,11 +74,12 @@ class JointsTest(unittest.TestCase):
         cls.set_joint_state = service('set_joint_state', SetJointState)
         cls.reset = service('reset', Trigger)
 
-    def spawn_urdf(self, name, urdf, z, joints=None):
+    def spawn_urdf(self, name, urdf, z, joints=None, x=0.0):
         request = SpawnRequest()
         request.name = name
         request.urdf_path = self.package + '/test/data/' + urdf
         request.pose = Pose()
+        request.pose.position.x = x
         request.pose.position.z = z
         request.pose.orientation.w = 1.0
         request.friction = -1.0
@@ -171,6 +172,70 @@ class JointsTest(unittest.TestCase):
         states = self.joint_states('arm2')
         self.assertAlmostEqual(0.0, states.position[0], delta=1e-12)
         self.assertAlmostEqual(0.2, states.position[1], delta=1e-12)
+
+    def test_hostile_joint_values_are_refused_by_name(self):
+        """Joint values beyond the request limits (README) are refused, naming the joint,
+        the field and the value, and change nothing."""
+        request = SpawnRequest(name='arm4', friction=-1.0, restitution=-1.0,
+                               urdf_path=self.package + '/test/data/two_link_arm.urdf',
+                               joint_names=['shoulder'], joint_positions=[1e300])
+        request.pose.position.z = 1.5
+        request.pose.orientation.w = 1.0
+        response = self.spawn(request)
+        self.assertFalse(response.success)
+        for word in ("joint_positions of 'shoulder'", '1e+300', '[-10000, 10000]'):
+            self.assertIn(word, response.message)
+        self.assertFalse(self.get_state('arm4').success)
+
+        self.spawn_urdf('arm4', 'two_link_arm.urdf', 1.5, {'elbow': 0.2})
+        for bad, words in (
+                (SetJointStateRequest(model='arm4', joint_names=['elbow'], positions=[0.0],
+                                      velocities=[1e300]),
+                 ("joint 'elbow' velocity", '1e+300 rad/s', '[-10000, 10000] rad/s')),
+                (SetJointStateRequest(model='arm4', joint_names=['elbow', 'elbow'],
+                                      positions=[0.0, 0.1]),
+                 ("joint_names[1] 'elbow'", 'given twice'))):
+            response = self.set_joint_state(bad)
+            self.assertFalse(response.success)
+            for word in words:
+                self.assertIn(word, response.message)
+        self.assertAlmostEqual(0.2, self.joint_states('arm4').position[1], delta=1e-12)
+
+        # Held by position servos, then a velocity beyond ~max_angular_speed
+        # and a joint named twice: both refused whole, the servos keep holding.
+        self.command('arm4', name=['shoulder', 'elbow'], position=[0.4, -0.3])
+        self.command('arm4', name=['elbow'], velocity=[1e300])
+        self.command('arm4', name=['shoulder', 'shoulder'], position=[1.0, 1.0])
+        self.step(240)
+        states = self.joint_states('arm4')
+        self.assertAlmostEqual(0.4, states.position[0], delta=1e-4)
+        self.assertAlmostEqual(-0.3, states.position[1], delta=1e-4)
+
+    def test_massless_base_and_joint_to_world_are_fixed_bases(self):
+        """Bullet's mass-0 root link, and a prismatic joint from 'world', fix the base where
+        the model is spawned; a cart on a vertical rail falls as z0 - g t^2 / 2."""
+        self.spawn_urdf('bullet_pendulum', 'massless_base_pendulum.urdf', 3.0, {'hinge': 0.5},
+                        x=-4.0)
+        self.spawn_urdf('pendulum_ref', 'pendulum.urdf', 3.0, {'hinge': 0.5}, x=4.0)
+        self.spawn_urdf('rail', 'vertical_rail.urdf', 5.0, x=8.0)
+        steps = 120
+        self.step(steps)
+        pivot = self.get_state('bullet_pendulum/pivot')
+        self.assertTrue(pivot.success, pivot.message)
+        self.assertAlmostEqual(3.0, pivot.pose.position.z, delta=1e-12)
+        self.assertAlmostEqual(-4.0, pivot.pose.position.x, delta=1e-12)
+        # It swings as pendulum.urdf does, whose base is fixed to 'world'.
+        reference = self.joint_states('pendulum_ref')
+        swung = self.joint_states('bullet_pendulum')
+        self.assertEqual(['hinge'], list(swung.name))
+        self.assertLess(swung.position[0], 0.45)
+        self.assertAlmostEqual(reference.position[0], swung.position[0], delta=1e-12)
+        self.assertAlmostEqual(reference.velocity[0], swung.velocity[0], delta=1e-12)
+        t = steps * DT
+        cart = self.get_state('rail/cart').pose.position
+        self.assertAlmostEqual(5.0 - 0.5 * G * t * t, cart.z, delta=1e-9)
+        self.assertAlmostEqual(8.0, cart.x, delta=1e-12)
+        self.assertAlmostEqual(0.0, cart.y, delta=1e-12)
 
     def test_trajectory_reaches_its_points_on_time(self):
         self.spawn_urdf('arm3', 'two_link_arm.urdf', 1.5)

@@ -37,6 +37,21 @@ inline constexpr double kMaxGravity = 1e3;          // m/s^2: |gravity|, and eac
 inline constexpr double kMaxFriction = 1e3;         // Coulomb mu of a spawn request
 inline constexpr double kMinQuaternionNorm = 1e-9;  // below: no rotation
 inline constexpr double kMaxQuaternionNorm = 1e9;
+// |position| of a joint in a request, rad or m: a continuous joint wound
+// further has lost its angle's precision below 1e-12 rad.
+inline constexpr double kMaxJointPosition = 1e4;
+
+// One joint's values in a request (spawn, ~set_joint_state, joint_command,
+// joint_trajectory): |position| <= kMaxJointPosition, |velocity| within
+// ~max_angular_speed (rad/s) or ~max_linear_speed (m/s) and |effort| within
+// ~max_torque (N m) or ~max_force (N), by the joint's kind.
+struct JointValues {
+  std::string field;       // names the values in a refusal: "joint 'elbow'"
+  bool prismatic = false;  // m, m/s and N; else rad, rad/s and N m
+  double position = 0.0;
+  double velocity = 0.0;
+  double effort = 0.0;
+};
 
 // The limits themselves: each positive and finite.
 physics::Status ValidateRequestLimits(const RequestLimits& limits);
@@ -46,6 +61,7 @@ physics::Status ValidateRequestLimits(const RequestLimits& limits);
 physics::Status ValidateFrameState(const FrameState& state, const RequestLimits& limits);
 // The state and the materials of a spawn request.
 physics::Status ValidateModelSpec(const ModelSpec& spec, const RequestLimits& limits);
+physics::Status ValidateJointValues(const JointValues& values, const RequestLimits& limits);
 // An apply_wrench request.
 physics::Status ValidateWrench(const physics::Vec3& force, const physics::Vec3& torque,
                                const physics::Vec3& point, double duration,

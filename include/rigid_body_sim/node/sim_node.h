@@ -212,6 +212,11 @@ class SimNode {
   ros::Publisher body_markers_publisher_;
   std::vector<ros::ServiceServer> services_;
   struct JointTopics {
+    // A handle of the model's own: roscpp's NodeHandle keeps a record of
+    // every publisher and subscriber made through it until the handle
+    // itself goes, so topics made through private_node_ would grow the
+    // node by some 300 bytes per spawn of an articulated model.
+    ros::NodeHandle handle;
     ros::Publisher states;
     ros::Subscriber command;
     ros::Subscriber trajectory;
