@@ -29,9 +29,11 @@ physics::Status ReadModes(const TiXmlElement& parent, const std::string& where,
       (*modes)[key] = MeshCollision::kTriangles;
     } else if (value == "hull") {
       (*modes)[key] = MeshCollision::kHull;
+    } else if (value == "decomposition") {
+      (*modes)[key] = MeshCollision::kDecomposition;
     } else {
       return physics::Status::Error(where + " <mesh_collision> value " + Quoted(value) +
-                                    " is not one of 'triangles', 'hull'");
+                                    " is not one of 'triangles', 'hull', 'decomposition'");
     }
   }
   return physics::Status::Ok();

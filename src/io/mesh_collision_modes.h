@@ -1,5 +1,5 @@
 // How a URDF <mesh> collides: the <gazebo reference="LINK"> extension
-// <mesh_collision>triangles|hull</mesh_collision>, for every mesh of the
+// <mesh_collision>triangles|hull|decomposition</mesh_collision>, for every mesh of the
 // link or, inside <collision name="NAME">, for one collision element.
 #ifndef RIGID_BODY_SIM_IO_MESH_COLLISION_MODES_H_
 #define RIGID_BODY_SIM_IO_MESH_COLLISION_MODES_H_
@@ -15,9 +15,11 @@
 namespace rigid_body_sim::io {
 
 enum class MeshCollision {
-  kDefault,    // triangles on a static model, the convex hull on a moving one
-  kTriangles,  // the triangles themselves (static models only)
-  kHull,       // the convex hull
+  kDefault,        // triangles on a static model; on a moving one the convex
+                   // hull, or convex pieces when the mesh is clearly concave
+  kTriangles,      // the triangles themselves (static models only)
+  kHull,           // the convex hull
+  kDecomposition,  // convex pieces (a closed mesh)
 };
 
 // Keyed by (link, collision name); the empty collision name is the link's.

@@ -1,5 +1,7 @@
 #include "rigid_body_sim/io/mesh_process.h"
 
+#include "io/mesh_process_internal.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -32,8 +34,6 @@ using physics::Vec3;
 
 // A hull of 1e5 vertices is about 10 MB of text; more is not a hull.
 constexpr std::size_t kMaxReplyBytes = std::size_t{64} << 20;
-// Cached hulls at most; past it the cache starts afresh.
-constexpr std::size_t kMaxCachedHulls = 1024;
 
 std::string Quoted(const std::string& text) { return "'" + text + "'"; }
 
@@ -43,13 +43,16 @@ std::string RefusalText(const std::string& reply) {
   return reply.substr(6, end == std::string::npos ? end : end - 6);
 }
 
+}  // namespace
+
+namespace internal {
+
 std::string HexFloat(double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%a", value);
   return buffer;
 }
 
-// The file is regular and small enough; checked before anything opens it.
 Result<struct stat> CheckFile(const std::string& path, std::uint64_t max_file_bytes) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0) {
@@ -66,6 +69,13 @@ Result<struct stat> CheckFile(const std::string& path, std::uint64_t max_file_by
   }
   return info;
 }
+
+}  // namespace internal
+
+namespace {
+
+using internal::CheckFile;
+using internal::HexFloat;
 
 std::string DescribeLimits(const MeshProcessLimits& limits) {
   std::ostringstream out;
@@ -268,11 +278,17 @@ Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
 }
 
 Result<ConvexPolyhedron> ParseHullReply(const std::string& reply, int max_vertices) {
+  if (reply.rfind("error ", 0) == 0) return Result<ConvexPolyhedron>::Error(RefusalText(reply));
+  std::istringstream in(reply);
+  return internal::ParseHull(in, max_vertices);
+}
+
+std::string internal::RefusalOf(const std::string& reply) { return RefusalText(reply); }
+
+Result<ConvexPolyhedron> internal::ParseHull(std::istream& in, int max_vertices) {
   const auto fail = [](const std::string& why) {
     return Result<ConvexPolyhedron>::Error("mesh helper reply: " + why);
   };
-  if (reply.rfind("error ", 0) == 0) return Result<ConvexPolyhedron>::Error(RefusalText(reply));
-  std::istringstream in(reply);
   std::string word;
   long vertex_count = 0;
   long face_count = 0;
@@ -307,15 +323,14 @@ Result<ConvexPolyhedron> ParseHullReply(const std::string& reply, int max_vertic
   return physics::MakeConvexPolyhedron(vertices, faces);
 }
 
-namespace {
-
 // The helper's reply to `arguments` about the file at `path`, or why there
 // is none: the file's own problem (checked before any process starts), the
 // helper's refusal (with the limits, since an allocation that failed at the
 // memory limit can look like a malformed file to the importer), its death,
 // or a reply past kMaxReplyBytes.
-Result<std::string> HelperReply(const std::vector<std::string>& arguments, const std::string& path,
-                                const MeshProcessLimits& limits) {
+Result<std::string> internal::HelperReply(const std::vector<std::string>& arguments,
+                                          const std::string& path,
+                                          const MeshProcessLimits& limits) {
   if (Result<struct stat> file = CheckFile(path, limits.max_file_bytes); !file.ok()) {
     return file.status();
   }
@@ -338,7 +353,7 @@ Result<std::string> HelperReply(const std::vector<std::string>& arguments, const
   return std::move(run->reply);
 }
 
-Status CheckScale(const std::string& path, const Vec3& scale) {
+Status internal::CheckScale(const std::string& path, const Vec3& scale) {
   if (!scale.allFinite() || (scale.array() == 0.0).any()) {
     return Status::Error("mesh " + Quoted(path) +
                          ": scale must be finite and non-zero on every axis");
@@ -346,7 +361,8 @@ Status CheckScale(const std::string& path, const Vec3& scale) {
   return Status::Ok();
 }
 
-}  // namespace
+using internal::CheckScale;
+using internal::HelperReply;
 
 Result<ConvexPolyhedron> LoadMeshHullOutOfProcess(const std::string& path, const Vec3& scale,
                                                   const HullOptions& hull,
@@ -397,64 +413,27 @@ Result<std::shared_ptr<const ConvexPolyhedron>> CachedMeshHull(const std::string
                                                                const Vec3& scale,
                                                                const HullOptions& hull,
                                                                const MeshProcessLimits& limits) {
-  using Key = std::tuple<std::string, double, double, double, int, double, std::int64_t,
-                         std::int64_t, std::int64_t>;
-  static std::mutex mutex;
-  static std::map<Key, std::shared_ptr<const ConvexPolyhedron>> cache;
-  Result<struct stat> file = CheckFile(path, limits.max_file_bytes);
-  if (!file.ok()) return file.status();
-  const Key key{path,
-                scale.x(),
-                scale.y(),
-                scale.z(),
-                hull.max_vertices,
-                hull.degenerate_tolerance,
-                static_cast<std::int64_t>(file->st_size),
-                static_cast<std::int64_t>(file->st_mtim.tv_sec),
-                static_cast<std::int64_t>(file->st_mtim.tv_nsec)};
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    const auto found = cache.find(key);
-    if (found != cache.end()) return found->second;
-  }
-  Result<ConvexPolyhedron> built = LoadMeshHullOutOfProcess(path, scale, hull, limits);
-  if (!built.ok()) return built.status();
-  auto shared = std::make_shared<const ConvexPolyhedron>(std::move(built).value());
-  std::lock_guard<std::mutex> lock(mutex);
-  if (cache.size() >= kMaxCachedHulls) cache.clear();
-  cache.emplace(key, shared);
-  return std::shared_ptr<const ConvexPolyhedron>(shared);
+  using Out = Result<std::shared_ptr<const ConvexPolyhedron>>;
+  const auto request = std::make_tuple(path, scale.x(), scale.y(), scale.z(), hull.max_vertices,
+                                       hull.degenerate_tolerance);
+  return internal::CachedByFile<ConvexPolyhedron>(path, request, limits, [&]() -> Out {
+    Result<ConvexPolyhedron> built = LoadMeshHullOutOfProcess(path, scale, hull, limits);
+    if (!built.ok()) return built.status();
+    return std::make_shared<const ConvexPolyhedron>(std::move(built).value());
+  });
 }
 
 Result<std::shared_ptr<const physics::CollisionMesh>> CachedMeshTriangles(
     const std::string& path, const Vec3& scale, const MeshProcessLimits& limits) {
   using Out = Result<std::shared_ptr<const physics::CollisionMesh>>;
-  using Key =
-      std::tuple<std::string, double, double, double, std::int64_t, std::int64_t, std::int64_t>;
-  static std::mutex mutex;
-  static std::map<Key, std::shared_ptr<const physics::CollisionMesh>> cache;
-  Result<struct stat> file = CheckFile(path, limits.max_file_bytes);
-  if (!file.ok()) return file.status();
-  const Key key{path,
-                scale.x(),
-                scale.y(),
-                scale.z(),
-                static_cast<std::int64_t>(file->st_size),
-                static_cast<std::int64_t>(file->st_mtim.tv_sec),
-                static_cast<std::int64_t>(file->st_mtim.tv_nsec)};
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    const auto found = cache.find(key);
-    if (found != cache.end()) return found->second;
-  }
-  Result<physics::TriangleMesh> triangles = LoadMeshTrianglesOutOfProcess(path, scale, limits);
-  if (!triangles.ok()) return triangles.status();
-  Out built = physics::CollisionMesh::Make(*triangles);
-  if (!built.ok()) return Out::Error("mesh " + Quoted(path) + ": " + built.message());
-  std::lock_guard<std::mutex> lock(mutex);
-  if (cache.size() >= kMaxCachedHulls) cache.clear();
-  cache.emplace(key, *built);
-  return built;
+  const auto request = std::make_tuple(path, scale.x(), scale.y(), scale.z());
+  return internal::CachedByFile<physics::CollisionMesh>(path, request, limits, [&]() -> Out {
+    Result<physics::TriangleMesh> triangles = LoadMeshTrianglesOutOfProcess(path, scale, limits);
+    if (!triangles.ok()) return triangles.status();
+    Out built = physics::CollisionMesh::Make(*triangles);
+    if (!built.ok()) return Out::Error("mesh " + Quoted(path) + ": " + built.message());
+    return built;
+  });
 }
 
 }  // namespace rigid_body_sim::io

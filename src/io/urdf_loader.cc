@@ -22,6 +22,7 @@
 #include "io/mesh_collision_modes.h"
 #include "io/urdf_checks.h"
 #include "io/urdf_elements.h"
+#include "io/urdf_meshes.h"
 
 namespace rigid_body_sim::io {
 namespace {
@@ -38,16 +39,11 @@ using physics::Vec3;
 
 constexpr char kWorldLink[] = "world";
 
-struct ShapeWithMass {
-  physics::ShapeGeometry geometry;
-  MassProperties mass_in_shape_frame;  // at the default density
-};
-
 // Builds one model; keeps caches across the links of that model.
 class ModelBuilder {
  public:
   ModelBuilder(const UrdfLoadOptions& options, UriResolver resolver)
-      : options_(options), resolver_(std::move(resolver)) {}
+      : options_(options), resolver_(resolver), meshes_(options, resolver) {}
 
   Result<LoadedModel> Build(const std::string& unpadded_xml) {
     // TinyXML (ours and urdfdom's) steps over a UTF-8 sequence by the length
@@ -132,6 +128,7 @@ class ModelBuilder {
     }
     loaded.root_link = body_root->name;
     static_model_ = loaded.is_static || options_.spawn_static;
+    meshes_.set_max_aspect_ratio(MaxAspectRatio(static_model_));
 
     std::vector<MassProperties> parts_in_root;
     const Status status = AddLinks(*body_root, &loaded, &parts_in_root);
@@ -327,15 +324,17 @@ class ModelBuilder {
       Result<ShapeWithMass> shape = MakeShape(*collision.geometry, where, mode);
       if (!shape.ok()) return shape.status();
       const Pose link_from_shape = ToPose(collision.origin);
-      LoadedShape loaded_shape;
-      loaded_shape.shape.geometry = shape->geometry;
-      loaded_shape.shape.body_from_shape = root_from_link * link_from_shape;
-      loaded_shape.link_name = link.name;
-      if (friction != friction_.end()) {
-        loaded_shape.shape.material.friction = friction->second;
-        loaded_shape.friction_from_urdf = true;
+      for (const physics::ShapeGeometry& geometry : shape->geometry) {
+        LoadedShape loaded_shape;
+        loaded_shape.shape.geometry = geometry;
+        loaded_shape.shape.body_from_shape = root_from_link * link_from_shape;
+        loaded_shape.link_name = link.name;
+        if (friction != friction_.end()) {
+          loaded_shape.shape.material.friction = friction->second;
+          loaded_shape.friction_from_urdf = true;
+        }
+        loaded->shapes.push_back(std::move(loaded_shape));
       }
-      loaded->shapes.push_back(std::move(loaded_shape));
       geometry_parts_in_link.push_back(
           physics::TransformMassProperties(shape->mass_in_shape_frame, link_from_shape));
     }
@@ -379,7 +378,7 @@ class ModelBuilder {
                                               FormatNumber(kMinShapeSize) + ", " +
                                               FormatNumber(kMaxShapeSize) + "] m");
         }
-        return ShapeWithMass{physics::Sphere{radius},
+        return ShapeWithMass{{physics::Sphere{radius}},
                              physics::SphereMassProperties(density, radius)};
       }
       case urdf::Geometry::BOX: {
@@ -395,7 +394,7 @@ class ModelBuilder {
         }
         Result<ConvexPolyhedron> box = physics::TryMakeBoxPolyhedron(size);
         if (!box.ok()) return Result<ShapeWithMass>::Error(where + ": " + box.message());
-        return ShapeWithMass{std::make_shared<const ConvexPolyhedron>(std::move(box).value()),
+        return ShapeWithMass{{std::make_shared<const ConvexPolyhedron>(std::move(box).value())},
                              physics::BoxMassProperties(density, size)};
       }
       case urdf::Geometry::CYLINDER: {
@@ -411,7 +410,7 @@ class ModelBuilder {
           return status;
         }
         return ShapeWithMass{
-            physics::Cylinder{cylinder.radius, 0.5 * cylinder.length},
+            {physics::Cylinder{cylinder.radius, 0.5 * cylinder.length}},
             physics::CylinderMassProperties(density, cylinder.radius, cylinder.length)};
       }
       case urdf::Geometry::MESH: {
@@ -421,106 +420,20 @@ class ModelBuilder {
           return Result<ShapeWithMass>::Error(
               where +
               ": <mesh_collision> 'triangles' needs a static model (is_static, or fixed "
-              "to 'world'); a moving mesh collides as its 'hull'");
+              "to 'world'); a moving mesh collides as its 'hull' or its 'decomposition'");
         }
         if (mode == MeshCollision::kTriangles ||
             (mode == MeshCollision::kDefault && static_model_)) {
-          return MeshTriangleShape(mesh.filename, scale, where);
+          return meshes_.Triangles(mesh.filename, scale, where);
         }
-        Result<std::shared_ptr<const ConvexPolyhedron>> hull = MeshHull(mesh.filename, scale);
-        if (!hull.ok()) return Result<ShapeWithMass>::Error(where + ": " + hull.message());
-        Vec3 lower = (*hull)->vertices.front();
-        Vec3 upper = lower;
-        for (const Vec3& vertex : (*hull)->vertices) {
-          lower = lower.cwiseMin(vertex);
-          upper = upper.cwiseMax(vertex);
-        }
-        if (Status status = CheckShapeExtents(upper - lower, where + " <mesh> hull",
-                                              MaxAspectRatio(static_model_));
-            !status.ok()) {
-          return status;
-        }
-        return ShapeWithMass{*hull, physics::PolyhedronMassProperties(density, **hull)};
+        if (mode == MeshCollision::kHull) return meshes_.Hull(mesh.filename, scale, where);
+        // A moving mesh that is clearly not convex is decomposed by default.
+        return meshes_.Pieces(
+            mesh.filename, scale,
+            mode == MeshCollision::kDecomposition ? PiecesRule::kAlways : PiecesRule::kAuto, where);
       }
     }
     return Result<ShapeWithMass>::Error(where + ": unknown geometry type");
-  }
-
-  // A static mesh that collides as its triangles. Its mass (for the link
-  // mass that GetModelProperties reports) is that of the solid it bounds
-  // when it is closed, else zero; a static model has no dynamics.
-  Result<ShapeWithMass> MeshTriangleShape(const std::string& uri, const Vec3& scale,
-                                          const std::string& where) {
-    using Out = Result<ShapeWithMass>;
-    Result<std::shared_ptr<const physics::CollisionMesh>> mesh = MeshTriangles(uri, scale);
-    if (!mesh.ok()) return Out::Error(where + ": " + mesh.message());
-    const Vec3 extent = (*mesh)->upper() - (*mesh)->lower();
-    if (!(extent.maxCoeff() <= kMaxShapeSize)) {
-      return Out::Error(where + " <mesh> triangles span " + FormatNumber(extent.maxCoeff()) +
-                        " m, above the allowed " + FormatNumber(kMaxShapeSize) + " m");
-    }
-    physics::TriangleMesh solid;
-    solid.vertices = (*mesh)->vertices();
-    for (const physics::CollisionMesh::Triangle& triangle : (*mesh)->triangles()) {
-      solid.triangles.emplace_back(triangle.vertices[0], triangle.vertices[1],
-                                   triangle.vertices[2]);
-    }
-    Result<MassProperties> mass =
-        physics::TriangleMeshMassProperties(options_.default_density, solid);
-    return ShapeWithMass{physics::StaticMesh{*mesh}, mass.ok() ? *mass : MassProperties{}};
-  }
-
-  // Triangles of a mesh file, shared by every collision element that uses
-  // the same file at the same scale.
-  Result<std::shared_ptr<const physics::CollisionMesh>> MeshTriangles(const std::string& uri,
-                                                                      const Vec3& scale) {
-    using Out = Result<std::shared_ptr<const physics::CollisionMesh>>;
-    const auto key = std::make_tuple(uri, scale.x(), scale.y(), scale.z());
-    const auto cached = triangle_meshes_.find(key);
-    if (cached != triangle_meshes_.end()) return cached->second;
-    Out built = Out::Error("");
-    if (options_.mesh_triangles_loader) {
-      const Result<std::string> path = resolver_(uri);
-      if (!path.ok()) return Out::Error("mesh " + Quoted(uri) + ": " + path.message());
-      built = options_.mesh_triangles_loader(*path, scale);
-    } else {
-      Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_, options_.max_file_bytes);
-      if (!mesh.ok()) return mesh.status();
-      built = physics::CollisionMesh::Make(*mesh);
-      if (!built.ok()) return Out::Error("mesh " + Quoted(uri) + ": " + built.message());
-    }
-    if (built.ok()) triangle_meshes_.emplace(key, *built);
-    return built;
-  }
-
-  // Hull of a mesh file, shared by every collision element that uses the
-  // same file at the same scale.
-  Result<std::shared_ptr<const ConvexPolyhedron>> MeshHull(const std::string& uri,
-                                                           const Vec3& scale) {
-    const auto key = std::make_tuple(uri, scale.x(), scale.y(), scale.z());
-    const auto cached = hulls_.find(key);
-    if (cached != hulls_.end()) return cached->second;
-    if (options_.mesh_hull_loader) {
-      const Result<std::string> path = resolver_(uri);
-      if (!path.ok()) {
-        return Result<std::shared_ptr<const ConvexPolyhedron>>::Error("mesh " + Quoted(uri) + ": " +
-                                                                      path.message());
-      }
-      Result<std::shared_ptr<const ConvexPolyhedron>> loaded =
-          options_.mesh_hull_loader(*path, scale, options_.hull);
-      if (loaded.ok()) hulls_.emplace(key, *loaded);
-      return loaded;
-    }
-    Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_, options_.max_file_bytes);
-    if (!mesh.ok()) return mesh.status();
-    Result<ConvexPolyhedron> hull = ComputeConvexHull(mesh->vertices, options_.hull);
-    if (!hull.ok()) {
-      return Result<std::shared_ptr<const ConvexPolyhedron>>::Error("mesh " + Quoted(uri) + ": " +
-                                                                    hull.message());
-    }
-    auto shared = std::make_shared<const ConvexPolyhedron>(std::move(hull).value());
-    hulls_.emplace(key, shared);
-    return std::shared_ptr<const ConvexPolyhedron>(shared);
   }
 
   const UrdfLoadOptions& options_;
@@ -529,11 +442,7 @@ class ModelBuilder {
   MeshCollisionModes mesh_modes_;
   bool static_model_ = false;  // fixed to `world`, massless, or spawned static
   bool massless_ = false;      // every link states mass 0
-  std::map<std::tuple<std::string, double, double, double>,
-           std::shared_ptr<const physics::CollisionMesh>>
-      triangle_meshes_;
-  std::map<std::tuple<std::string, double, double, double>, std::shared_ptr<const ConvexPolyhedron>>
-      hulls_;
+  UrdfMeshes meshes_;
 };
 
 Status ValidateOptions(const UrdfLoadOptions& options) {

@@ -63,6 +63,20 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
                                                       const physics::Vec3& scale) {
     return io::CachedMeshTriangles(path, scale, mesh_limits);
   };
+  // Concave moving meshes: decomposed in the helper, results kept on disk.
+  const std::string cache_directory = io::DefaultDecompositionCacheDirectory();
+  load_options_.mesh_pieces_loader = [mesh_limits, cache_directory](
+                                         const std::string& path, const physics::Vec3& scale,
+                                         const io::DecompositionOptions& decomposition,
+                                         io::PiecesRule rule) {
+    io::MeshPiecesRequest request;
+    request.path = path;
+    request.scale = scale;
+    request.options = decomposition;
+    request.rule = rule;
+    request.cache_directory = cache_directory;
+    return io::CachedMeshPieces(request, mesh_limits);
+  };
   load_options_.resolver = ResolveRosUri;
   // Movable joints are simulated: a model with any becomes an articulation.
   load_options_.articulate = true;

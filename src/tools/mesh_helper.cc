@@ -8,7 +8,11 @@
 //        DEGENERATE_TOLERANCE MEMORY_BYTES CPU_SECONDS MAX_FILE_BYTES
 //    or: rigid_body_sim_mesh_helper --triangles PATH SX SY SZ MEMORY_BYTES
 //        CPU_SECONDS MAX_FILE_BYTES
-// (the triangles themselves, for a static mesh that collides as them).
+// (the triangles themselves, for a static mesh that collides as them)
+//    or: rigid_body_sim_mesh_helper --pieces PATH SX SY SZ auto|always
+//        MAX_VERTICES DEGENERATE_TOLERANCE VOXELS MAX_PIECES MAX_CONCAVITY
+//        BALANCE MERGE CONVEX_RATIO MEMORY_BYTES CPU_SECONDS MAX_FILE_BYTES
+// (the convex pieces of a moving mesh, io/convex_decomposition.h).
 #include <sys/resource.h>
 
 #include <cstdio>
@@ -16,6 +20,7 @@
 #include <new>
 #include <string>
 
+#include "rigid_body_sim/io/convex_decomposition.h"
 #include "rigid_body_sim/io/convex_hull.h"
 #include "rigid_body_sim/io/mesh_loader.h"
 #include "rigid_body_sim/io/mesh_process.h"
@@ -85,12 +90,61 @@ int ReplyTriangles(int argc, char** argv) {
   }
 }
 
+// --pieces: the mesh's convex pieces.
+int ReplyPieces(int argc, char** argv) {
+  using rigid_body_sim::io::FormatErrorReply;
+  if (argc != 18) return Reply(FormatErrorReply("mesh helper: expected 17 arguments"), 2);
+  const std::string path = argv[2];
+  const rigid_body_sim::physics::Vec3 scale(
+      std::strtod(argv[3], nullptr), std::strtod(argv[4], nullptr), std::strtod(argv[5], nullptr));
+  const std::string rule_name = argv[6];
+  if (rule_name != "auto" && rule_name != "always") {
+    return Reply(FormatErrorReply("mesh helper: rule '" + rule_name + "' is not auto or always"),
+                 2);
+  }
+  rigid_body_sim::io::DecompositionOptions options;
+  options.hull.max_vertices = std::atoi(argv[7]);
+  options.hull.degenerate_tolerance = std::strtod(argv[8], nullptr);
+  options.voxel_count = std::atoi(argv[9]);
+  options.max_pieces = std::atoi(argv[10]);
+  options.max_concavity = std::strtod(argv[11], nullptr);
+  options.balance_weight = std::strtod(argv[12], nullptr);
+  options.merge_volume = std::strtod(argv[13], nullptr);
+  options.convex_ratio = std::strtod(argv[14], nullptr);
+  const unsigned long long memory_bytes = std::strtoull(argv[15], nullptr, 10);
+  const double cpu_seconds = std::strtod(argv[16], nullptr);
+  const unsigned long long max_file_bytes = std::strtoull(argv[17], nullptr, 10);
+  if (!LimitSelf(static_cast<rlim_t>(memory_bytes), cpu_seconds)) {
+    return Reply(FormatErrorReply("mesh helper: setrlimit failed"), 2);
+  }
+  try {
+    const auto as_is = [](const std::string& uri) -> Result<std::string> { return uri; };
+    const Result<rigid_body_sim::physics::TriangleMesh> mesh =
+        rigid_body_sim::io::LoadMesh(path, scale, as_is, max_file_bytes);
+    if (!mesh.ok()) return Reply(FormatErrorReply(mesh.message()), 1);
+    const auto rule = rule_name == "auto" ? rigid_body_sim::io::PiecesRule::kAuto
+                                          : rigid_body_sim::io::PiecesRule::kAlways;
+    const auto pieces = rigid_body_sim::io::ConvexPieces(*mesh, options, rule);
+    if (!pieces.ok()) return Reply(FormatErrorReply("mesh '" + path + "': " + pieces.message()), 1);
+    return Reply(rigid_body_sim::io::FormatPiecesReply(*pieces), 0);
+  } catch (const std::bad_alloc&) {
+    return Reply(FormatErrorReply("mesh '" + path + "': out of memory in the mesh helper (limit " +
+                                  std::to_string(memory_bytes) + " bytes)"),
+                 1);
+  } catch (const std::exception& error) {
+    return Reply(FormatErrorReply("mesh '" + path + "': " + error.what()), 1);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using rigid_body_sim::io::FormatErrorReply;
   if (argc > 1 && std::string(argv[1]) == rigid_body_sim::io::kTrianglesFlag) {
     return ReplyTriangles(argc, argv);
+  }
+  if (argc > 1 && std::string(argv[1]) == rigid_body_sim::io::kPiecesFlag) {
+    return ReplyPieces(argc, argv);
   }
   if (argc != 10) return Reply(FormatErrorReply("mesh helper: expected 9 arguments"), 2);
   const std::string path = argv[1];

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "rigid_body_sim/io/convex_decomposition.h"
 #include "rigid_body_sim/io/convex_hull.h"
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
@@ -56,8 +57,47 @@ physics::Result<physics::TriangleMesh> LoadMeshTrianglesOutOfProcess(
 physics::Result<std::shared_ptr<const physics::CollisionMesh>> CachedMeshTriangles(
     const std::string& path, const physics::Vec3& scale, const MeshProcessLimits& limits);
 
+// A moving mesh's convex pieces (convex_decomposition.h), decomposed by
+// the helper.
+struct MeshPiecesRequest {
+  std::string path;  // a local path, already resolved
+  physics::Vec3 scale = physics::Vec3::Ones();
+  DecompositionOptions options;
+  PiecesRule rule = PiecesRule::kAuto;
+  // Where results are kept on disk, keyed by a hash of the file's bytes and
+  // every setting above, so a mesh decomposed once (by any run) costs no
+  // process again; empty: no disk cache. A cache file that cannot be read
+  // or written is ignored (the helper runs); one that does not parse is
+  // replaced.
+  std::string cache_directory;
+};
+using ConvexPieceList = std::vector<physics::ConvexPolyhedron>;
+
+// The pieces of the mesh at request.path: from the disk cache, else built
+// by the helper (and then stored in the cache). Fails as
+// LoadMeshHullOutOfProcess does.
+physics::Result<ConvexPieceList> LoadMeshPiecesOutOfProcess(const MeshPiecesRequest& request,
+                                                            const MeshProcessLimits& limits);
+
+// As above, through a process-wide cache keyed by the request, the file's
+// size and modification time. Thread-safe.
+physics::Result<std::shared_ptr<const ConvexPieceList>> CachedMeshPieces(
+    const MeshPiecesRequest& request, const MeshProcessLimits& limits);
+
+// $ROS_HOME/rigid_body_sim/decomposition, else
+// $HOME/.ros/rigid_body_sim/decomposition, else "" (no disk cache).
+std::string DefaultDecompositionCacheDirectory();
+
 // The helper's first argument that asks for triangles instead of a hull.
 inline constexpr char kTrianglesFlag[] = "--triangles";
+// The helper's first argument that asks for convex pieces.
+inline constexpr char kPiecesFlag[] = "--pieces";
+// The pieces reply: "pieces N" and N hull replies.
+std::string FormatPiecesReply(const ConvexPieceList& pieces);
+// Parses a pieces reply of 1 to kMaxPieces hulls of at most `max_vertices`
+// vertices each, or returns the helper's error.
+physics::Result<ConvexPieceList> ParsePiecesReply(const std::string& reply, int max_vertices);
+inline constexpr int kMaxPieces = 64;
 
 // The helper's side, shared with it and with the fuzzer: the reply that
 // carries a hull through the pipe, and its parsing. The text holds

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "rigid_body_sim/io/convex_decomposition.h"
 #include "rigid_body_sim/io/convex_hull.h"
 #include "rigid_body_sim/io/mesh_loader.h"
 #include "rigid_body_sim/physics/articulation.h"
@@ -43,6 +44,14 @@ using MeshTrianglesLoader =
     std::function<physics::Result<std::shared_ptr<const physics::CollisionMesh>>(
         const std::string& path, const physics::Vec3& scale)>;
 
+// The convex pieces of the mesh file at a resolved local `path`, scaled per
+// axis (ConvexPieces); e.g. CachedMeshPieces (mesh_process.h), out of
+// process.
+using MeshPiecesLoader =
+    std::function<physics::Result<std::shared_ptr<const std::vector<physics::ConvexPolyhedron>>>(
+        const std::string& path, const physics::Vec3& scale, const DecompositionOptions& options,
+        PiecesRule rule)>;
+
 struct UrdfLoadOptions {
   // kg/m^3: density of links without <inertial>, whose mass properties are
   // computed from their collision geometry.
@@ -58,6 +67,13 @@ struct UrdfLoadOptions {
   // When set, the triangles of static meshes come from it; when empty, they
   // are imported in this process (LoadMesh).
   MeshTrianglesLoader mesh_triangles_loader;
+  // A moving model's meshes: by default a closed mesh whose volume is below
+  // decomposition.convex_ratio of its hull's collides as convex pieces,
+  // others as their hull; <mesh_collision>decomposition asks for pieces,
+  // `hull` for the hull. The pieces come from mesh_pieces_loader when set,
+  // else are built in this process.
+  DecompositionOptions decomposition;
+  MeshPiecesLoader mesh_pieces_loader;
   // The caller spawns the model static whatever its URDF says (a spawn
   // request's is_static): its meshes then keep their triangles by default,
   // as those of a model fixed to `world` do. A <gazebo reference="LINK">

@@ -1,0 +1,190 @@
+#!/usr/bin/env python3
+"""Concave meshes through the ROS interface (issue 24).
+
+Moving meshes that are clearly not convex collide as convex pieces (a mug
+holds a ball; an L-bracket straddles a box on its two feet); static meshes
+collide as their triangles (a box lands on a bin's floor; a ball rolls under
+a table). Every scene has its own place in the world, so they do not meet.
+Run by concave_test.test: the node starts paused and the test steps it.
+The meshes come from test/data/make_decomposition_meshes.py.
+"""
+
+import math
+import os
+import time
+import unittest
+
+import rospkg
+import rospy
+from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Vector3
+from rigid_body_sim.srv import Delete, GetPhysics, GetState, Spawn, SpawnRequest, Step
+
+PKG = 'rigid_body_sim'
+SIM = '/rigid_body_sim/'
+GRAVITY = 9.81  # m/s^2, the node's default
+CONTACT_SLOP = 0.001  # m: resting bodies sink at most this far into what holds them
+
+
+def service(name, service_type):
+    rospy.wait_for_service(SIM + name, timeout=60)
+    return rospy.ServiceProxy(SIM + name, service_type)
+
+
+def mesh_urdf(name, mesh_path, mode=None):
+    """A one-link model colliding as the mesh, mass from its geometry."""
+    gazebo = ('<gazebo reference="body"><mesh_collision>%s</mesh_collision></gazebo>' % mode
+              if mode else '')
+    return ('<robot name="%s"><link name="body"><collision><geometry><mesh filename="%s"/>'
+            '</geometry></collision></link>%s</robot>' % (name, mesh_path, gazebo))
+
+
+def primitive_urdf(name, geometry):
+    return ('<robot name="%s"><link name="body"><collision><geometry>%s</geometry></collision>'
+            '</link></robot>' % (name, geometry))
+
+
+def pose(x, y, z, pitch=0.0):
+    """A pose turned by `pitch` about the world y axis."""
+    return Pose(Point(x, y, z), Quaternion(0.0, math.sin(pitch / 2), 0.0, math.cos(pitch / 2)))
+
+
+class ConcaveTest(unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        cls.data = os.path.join(rospkg.RosPack().get_path(PKG), 'test', 'data')
+        cls.urdf_dir = os.path.join(rospkg.RosPack().get_path(PKG), 'urdf')
+
+    def setUp(self):
+        self.spawn_service = service('spawn', Spawn)
+        self.get_state = service('get_state', GetState)
+        self.step_service = service('step', Step)
+        self.delete = service('delete', Delete)
+        self.time_step = service('get_physics', GetPhysics)().time_step
+
+    def spawn(self, name, urdf='', urdf_path='', at=None, twist=None, is_static=False):
+        request = SpawnRequest(name=name, urdf=urdf, urdf_path=urdf_path, pose=at or pose(0, 0, 0),
+                               is_static=is_static, friction=-1.0, restitution=-1.0)
+        if twist is not None:
+            request.twist = twist
+        result = self.spawn_service(request)
+        self.assertTrue(result.success, result.message)
+        return result
+
+    def run_for(self, seconds):
+        result = self.step_service(int(round(seconds / self.time_step)))
+        self.assertTrue(result.success, result.message)
+
+    def state(self, name):
+        state = self.get_state(name)
+        self.assertTrue(state.success, state.message)
+        return state
+
+    def test_mug_holds_a_ball_and_its_second_spawn_is_fast(self):
+        mug = mesh_urdf('mug', os.path.join(self.data, 'mug.stl'))
+        # Upright at (0, 5) on the ground; the ball (radius 1 cm) above the
+        # cavity, whose floor is 1 cm above the mug's base.
+        self.spawn('mug', urdf=mug, at=pose(0.0, 5.0, 0.001))
+        started = time.monotonic()
+        self.spawn('mug_again', urdf=mug, at=pose(1.0, 5.0, 0.001))
+        second = time.monotonic() - started
+        rospy.loginfo('second spawn of the decomposed mug: %.1f ms', 1000 * second)
+        self.assertLess(second, 0.05)
+        self.spawn('marble', urdf=primitive_urdf('marble', '<sphere radius="0.01"/>'),
+                   at=pose(0.003, 5.002, 0.07))
+        self.run_for(2.0)
+        mug_position = self.state('mug').pose.position
+        ball = self.state('marble').pose.position
+        # The ball rests on the cavity floor: its centre one radius above
+        # z = 0.01, inside the 3.5 cm cavity wall. The pieces may raise the
+        # floor: a floor piece's hull exceeds its part by at most 1 % of the
+        # mug's volume V (max_concavity), so over a quarter of the cavity's
+        # floor area A it rises at most 0.01 V / (A / 4). The mug's hull
+        # would have held the ball on the rim's lid at z = 0.11.
+        segments = 32
+        area = 0.5 * segments * math.sin(2.0 * math.pi / segments)  # of a unit-radius 32-gon
+        volume = area * (0.04 ** 2 * 0.10 - 0.035 ** 2 * 0.09)
+        floor_fill = 0.01 * volume / (area * 0.035 ** 2 / 4.0)
+        self.assertAlmostEqual(0.0, mug_position.z, delta=CONTACT_SLOP)
+        self.assertGreater(ball.z, 0.02 - CONTACT_SLOP)
+        self.assertLess(ball.z, 0.02 + floor_fill)
+        rospy.loginfo('ball at z = %.5f m on the cavity floor (0.02 m, fill bound %.5f m)',
+                      ball.z, floor_fill)
+        self.assertLess(math.hypot(ball.x - mug_position.x, ball.y - mug_position.y),
+                        0.035 - 0.01 + 1e-6)
+        for name in ('mug', 'mug_again', 'marble'):
+            self.delete(name)
+
+    def test_l_bracket_straddles_a_box_on_its_two_feet(self):
+        # The L's profile (x, z) is extreme along (1, 1) at its legs' inner
+        # tip corners (0.3, 0.05) and (0.05, 0.3), x + z = 0.35. Pitched by
+        # 135 deg about y those point straight down: the L stands on them,
+        # its corner up, its outer corner (the model origin) 0.35 / sqrt(2)
+        # above the ground, the notch between the legs 0.25 / sqrt(2) high
+        # at its apex and 0.354 m wide at the ground. A 10 cm box fits under
+        # it (notch 0.127 m high 5 cm off centre); the L's hull would rest on
+        # the box's top, 0.1 m higher.
+        pitch = 0.75 * math.pi
+        rest_height = 0.35 / math.sqrt(2.0)
+        self.spawn('block', urdf=primitive_urdf('block', '<box size="0.1 0.1 0.1"/>'),
+                   at=pose(0.0, 10.05, 0.05), is_static=True)
+        self.spawn('bracket', urdf=mesh_urdf('bracket', os.path.join(self.data, 'l_bracket.stl')),
+                   at=pose(0.0, 10.0, rest_height + 0.01, pitch))
+        self.run_for(2.0)
+        state = self.state('bracket')
+        rospy.loginfo('bracket origin at z = %.5f m (analytic %.5f m), x = %.5f m, pitch %.5f rad',
+                      state.pose.position.z, rest_height, state.pose.position.x,
+                      2.0 * math.atan2(state.pose.orientation.y, state.pose.orientation.w))
+        self.assertAlmostEqual(rest_height, state.pose.position.z, delta=CONTACT_SLOP)
+        self.assertAlmostEqual(0.0, state.pose.position.x, delta=0.001)
+        q = state.pose.orientation
+        # Still turned about y only, by 135 deg.
+        self.assertAlmostEqual(0.0, math.hypot(q.x, q.z), delta=1e-3)
+        self.assertAlmostEqual(pitch, 2.0 * math.atan2(q.y, q.w), delta=2e-3)
+        for name in ('block', 'bracket'):
+            self.delete(name)
+
+    def test_box_dropped_into_the_bin_rests_on_its_floor(self):
+        # bin.urdf: the floor's top 5 mm above the underside; a 10 cm box
+        # rests with its centre 5 cm above it.
+        self.spawn('bin', urdf_path=os.path.join(self.urdf_dir, 'bin.urdf'),
+                   at=pose(0.0, -5.0, 0.0))
+        self.spawn('crate', urdf=primitive_urdf('crate', '<box size="0.1 0.1 0.1"/>'),
+                   at=pose(0.02, -5.01, 0.3))
+        self.run_for(2.0)
+        crate_z = self.state('crate').pose.position.z
+        rospy.loginfo('crate in the bin at z = %.5f m (analytic 0.055 m)', crate_z)
+        self.assertAlmostEqual(0.005 + 0.05, crate_z, delta=0.001)
+        for name in ('bin', 'crate'):
+            self.delete(name)
+
+    def test_ball_rolls_under_the_mesh_table(self):
+        # mesh_table.urdf: a 1.0 x 0.8 m top from z = 0.27 m, legs at the
+        # corners, so a 5 cm ball rolled along x between the legs passes
+        # under it. Launched sliding at v0 = 1 m/s without spin, friction
+        # mu = sqrt(0.5 * 0.8) (the default and the ground's, combined as the
+        # geometric mean) brings it to rolling at 5/7 v0 after
+        # t_s = 2 v0 / (7 mu g); by time t it has covered 5/7 v0 t + v0 t_s / 7.
+        self.spawn('table', urdf_path=os.path.join(self.urdf_dir, 'mesh_table.urdf'),
+                   at=pose(5.0, 0.0, 0.0))
+        self.spawn('rolling_ball', urdf=primitive_urdf('rolling_ball', '<sphere radius="0.025"/>'),
+                   at=pose(5.0 - 0.8, 0.0, 0.025), twist=Twist(Vector3(1.0, 0.0, 0.0), Vector3()))
+        self.run_for(2.5)
+        ball = self.state('rolling_ball').pose.position
+        travelled = ball.x - (5.0 - 0.8)
+        rolling_speed = 5.0 / 7.0
+        slip_time = 2.0 / (7.0 * math.sqrt(0.5 * 0.8) * GRAVITY)
+        rospy.loginfo('ball rolled %.5f m under the table (analytic %.5f m), now at x = %.4f',
+                      travelled, rolling_speed * 2.5 + slip_time / 7.0, ball.x)
+        self.assertAlmostEqual(rolling_speed * 2.5 + slip_time / 7.0, travelled, delta=0.003)
+        self.assertGreater(ball.x, 5.0 + 0.5 + 0.025)  # out past the table's far edge
+        self.assertAlmostEqual(0.0, ball.y, delta=0.001)
+        self.assertAlmostEqual(0.025, ball.z, delta=CONTACT_SLOP)
+        for name in ('table', 'rolling_ball'):
+            self.delete(name)
+
+
+if __name__ == '__main__':
+    import rostest
+    rospy.init_node('concave_test', anonymous=True)
+    rostest.rosrun(PKG, 'concave', ConcaveTest)
