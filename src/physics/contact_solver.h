@@ -226,6 +226,9 @@ class ContactSolver {
   // group (one thread, or one island) is the reference order.
   std::vector<std::vector<SweepTask>> schedules_;
   std::vector<std::uint32_t> island_group_;  // per island, its group
+  // Per group, the tasks of its schedule with a row penetrating beyond the
+  // slop: the only ones the split impulse's sweeps change anything in.
+  std::vector<std::vector<SweepTask>> pseudo_schedules_;
   std::vector<RestingIsland> islands_;
   // Each row's island; with the rest, scratch of FindIslands kept for its
   // memory.

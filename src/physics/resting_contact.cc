@@ -49,10 +49,28 @@ void ContactSolver::SolveRestingContacts() {
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
   // without touching the real velocities, so no energy is added. The same
-  // schedules, every island, each group on its thread.
-  RunGroups(pool_, schedules_.size(), [this](std::size_t group) {
+  // schedules, every island, each group on its thread; a task none of whose
+  // rows penetrates beyond the slop is left out, as its updates change
+  // nothing (UpdatePseudoRow returns at once), so the result is the same
+  // bit for bit while a settled pile's sweeps skip most rows.
+  pseudo_schedules_.resize(schedules_.size());
+  auto penetrates = [this](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t r = begin; r < end; ++r) {
+      if (rows_[r].depth > 0.0) return true;
+    }
+    return false;
+  };
+  RunGroups(pool_, schedules_.size(), [&](std::size_t group) {
+    std::vector<SweepTask>& pseudo = pseudo_schedules_[group];
+    pseudo.clear();
+    for (const SweepTask& task : schedules_[group]) {
+      if (penetrates(task.first_begin, task.first_end) ||
+          penetrates(task.second_begin, task.second_end)) {
+        pseudo.push_back(task);
+      }
+    }
     for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
-      SweepSchedule</*kPseudo=*/true>(schedules_[group]);
+      SweepSchedule</*kPseudo=*/true>(pseudo);
     }
   });
   for (const RestingRow& row : rows_) {

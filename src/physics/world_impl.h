@@ -180,7 +180,14 @@ class WorldImpl {
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;      // settings_.threads threads
   std::vector<NarrowJob> narrow_jobs_;  // stage 2's, in the order the pairs were visited
-  std::vector<Body> bodies_;            // slots; a destroyed body's slot is reused
+  // FindImpacts' per pair: the time of impact (s, +infinity for none) and
+  // the speed the surfaces meet at (m/s).
+  struct ImpactSearch {
+    double time = 0.0;
+    double approach_speed = 0.0;
+  };
+  std::vector<ImpactSearch> impact_searches_;
+  std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;
   double time_ = 0.0;
