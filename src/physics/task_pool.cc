@@ -9,9 +9,7 @@ int ResolveThreadCount(int threads) {
 }
 
 TaskPool::TaskPool(int threads) {
-  for (int index = 1; index < threads; ++index) {
-    workers_.emplace_back([this, index] { WorkerLoop(index); });
-  }
+  for (int index = 1; index < threads; ++index) workers_.emplace_back([this] { WorkerLoop(); });
 }
 
 TaskPool::~TaskPool() {
@@ -23,40 +21,41 @@ TaskPool::~TaskPool() {
   for (std::thread& worker : workers_) worker.join();
 }
 
-void TaskPool::RunOnAll(const std::function<void(int)>& task) {
-  if (workers_.empty()) {
-    task(0);
-    return;
-  }
+void TaskPool::Share(const std::function<void()>& work) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    task_ = &task;
-    pending_ = static_cast<int>(workers_.size());
+    job_ = &work;
+    open_ = true;
     ++generation_;
   }
   start_.notify_all();
-  task(0);
+  work();
+  // Every index is taken. Workers that wake from now on skip the job; the
+  // ones running it finish their chunks.
   std::unique_lock<std::mutex> lock(mutex_);
-  done_.wait(lock, [this] { return pending_ == 0; });
-  task_ = nullptr;
+  open_ = false;
+  done_.wait(lock, [this] { return active_ == 0; });
+  job_ = nullptr;
 }
 
-void TaskPool::WorkerLoop(int index) {
+void TaskPool::WorkerLoop() {
   std::uint64_t seen = 0;
   for (;;) {
-    const std::function<void(int)>* task = nullptr;
+    const std::function<void()>* job = nullptr;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       start_.wait(lock, [&] { return stop_ || generation_ != seen; });
       if (stop_) return;
       seen = generation_;
-      task = task_;
+      if (!open_) continue;
+      job = job_;
+      ++active_;
     }
-    (*task)(index);
+    (*job)();
     bool last = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      last = --pending_ == 0;
+      last = --active_ == 0;
     }
     if (last) done_.notify_one();
   }
