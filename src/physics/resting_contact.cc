@@ -13,14 +13,19 @@ namespace rigid_body_sim::physics {
 namespace {
 
 // Calls run(group) for each group, on the pool's threads when there are
-// several groups, else on the caller's; a thread takes one group at a time.
+// several groups (at most one per thread), else on the caller's.
 template <typename Run>
 void RunGroups(TaskPool* pool, std::size_t group_count, const Run& run) {
   if (group_count == 1 || pool == nullptr) {
     for (std::size_t group = 0; group < group_count; ++group) run(group);
     return;
   }
-  pool->ParallelFor(group_count, 1, run);
+  const auto threads = static_cast<std::size_t>(pool->threads());
+  pool->RunOnAll([&](int thread) {
+    for (auto group = static_cast<std::size_t>(thread); group < group_count; group += threads) {
+      run(group);
+    }
+  });
 }
 
 }  // namespace

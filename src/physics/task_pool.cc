@@ -9,7 +9,9 @@ int ResolveThreadCount(int threads) {
 }
 
 TaskPool::TaskPool(int threads) {
-  for (int index = 1; index < threads; ++index) workers_.emplace_back([this] { WorkerLoop(); });
+  for (int index = 1; index < threads; ++index) {
+    workers_.emplace_back([this, index] { WorkerLoop(index); });
+  }
 }
 
 TaskPool::~TaskPool() {
@@ -21,41 +23,40 @@ TaskPool::~TaskPool() {
   for (std::thread& worker : workers_) worker.join();
 }
 
-void TaskPool::Share(const std::function<void()>& work) {
+void TaskPool::RunOnAll(const std::function<void(int)>& task) {
+  if (workers_.empty()) {
+    task(0);
+    return;
+  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    job_ = &work;
-    open_ = true;
+    task_ = &task;
+    pending_ = static_cast<int>(workers_.size());
     ++generation_;
   }
   start_.notify_all();
-  work();
-  // Every index is taken. Workers that wake from now on skip the job; the
-  // ones running it finish their chunks.
+  task(0);
   std::unique_lock<std::mutex> lock(mutex_);
-  open_ = false;
-  done_.wait(lock, [this] { return active_ == 0; });
-  job_ = nullptr;
+  done_.wait(lock, [this] { return pending_ == 0; });
+  task_ = nullptr;
 }
 
-void TaskPool::WorkerLoop() {
+void TaskPool::WorkerLoop(int index) {
   std::uint64_t seen = 0;
   for (;;) {
-    const std::function<void()>* job = nullptr;
+    const std::function<void(int)>* task = nullptr;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       start_.wait(lock, [&] { return stop_ || generation_ != seen; });
       if (stop_) return;
       seen = generation_;
-      if (!open_) continue;
-      job = job_;
-      ++active_;
+      task = task_;
     }
-    (*job)();
+    (*task)(index);
     bool last = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      last = --active_ == 0;
+      last = --pending_ == 0;
     }
     if (last) done_.notify_one();
   }

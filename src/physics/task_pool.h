@@ -1,15 +1,8 @@
-// A small fork-join pool of threads for the stages of a step. ParallelFor
-// shares the indices of one loop among the caller and threads() - 1
-// workers, in chunks that each thread takes while any are left, and returns
-// when every index is done. The stages hand it work whose result does not
-// depend on which thread does which part (each index writes only what it
-// owns), so a step's result is the same for any number of threads.
-//
-// The caller never waits for a worker that has not started: it takes
-// chunks itself, and once none are left it waits only for the workers that
-// are still running one. On a machine with no core to spare, a worker that
-// the scheduler has not run yet costs the step nothing; the step then takes
-// as long as on one thread.
+// A small fork-join pool of threads for the stages of a step: the caller and
+// threads() - 1 workers run one task together, and the call returns when all
+// of them have finished it. The stages hand it work whose result does not
+// depend on which thread does which part (each part writes only its own
+// outputs), so a step's result is the same for any number of threads.
 #ifndef RIGID_BODY_SIM_PHYSICS_TASK_POOL_H_
 #define RIGID_BODY_SIM_PHYSICS_TASK_POOL_H_
 
@@ -34,19 +27,23 @@ class TaskPool {
 
   int threads() const { return static_cast<int>(workers_.size()) + 1; }
 
+  // Runs task(t) once for each t in [0, threads()), t = 0 on the calling
+  // thread, and returns when every call has returned. Not reentrant: a
+  // task must not call RunOnAll.
+  void RunOnAll(const std::function<void(int)>& task);
+
   // Calls body(i) for every i in [0, count): the threads take chunks of
   // `chunk` consecutive indices in turn until none are left, so uneven
   // parts balance. Which thread runs an index is left to the schedule;
-  // body must write only what index i owns. Not reentrant: body must not
-  // call ParallelFor.
+  // body must write only what index i owns.
   template <typename Body>
   void ParallelFor(std::size_t count, std::size_t chunk, const Body& body) {
-    if (workers_.empty() || count <= chunk) {
+    if (threads() == 1 || count <= chunk) {
       for (std::size_t i = 0; i < count; ++i) body(i);
       return;
     }
     std::atomic<std::size_t> next{0};
-    Share([&] {
+    RunOnAll([&](int) {
       for (;;) {
         const std::size_t begin = next.fetch_add(chunk, std::memory_order_relaxed);
         if (begin >= count) return;
@@ -57,20 +54,15 @@ class TaskPool {
   }
 
  private:
-  // Runs `work` on the caller and on every worker that wakes while it is
-  // open; `work` returns once nothing is left to take. Returns when the
-  // caller's call and every worker's call that started have returned.
-  void Share(const std::function<void()>& work);
-  void WorkerLoop();
+  void WorkerLoop(int index);
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
-  std::condition_variable start_;  // a new job, or stop_
-  std::condition_variable done_;   // active_ reached 0
-  const std::function<void()>* job_ = nullptr;
-  std::uint64_t generation_ = 0;  // counts the jobs handed out
-  bool open_ = false;             // workers that wake may still join job_
-  int active_ = 0;                // workers running job_
+  std::condition_variable start_;  // a new task, or stop_
+  std::condition_variable done_;   // pending_ reached 0
+  const std::function<void(int)>* task_ = nullptr;
+  std::uint64_t generation_ = 0;  // counts the tasks handed out
+  int pending_ = 0;               // workers still running the current task
   bool stop_ = false;
 };
 

@@ -43,16 +43,13 @@ TEST(TaskPoolTest, ParallelForVisitsEveryIndexOnce) {
   }
 }
 
-// Many short loops in a row, as a step makes them: each returns only after
-// every index of it is done, and no index of one loop runs in another
-// (workers that wake late skip a loop already finished).
-TEST(TaskPoolTest, ConsecutiveLoopsEachFinishBeforeReturning) {
+TEST(TaskPoolTest, RunOnAllCallsEachThreadIndexOnceAndWaits) {
   TaskPool pool(3);
-  for (int round = 0; round < 2000; ++round) {
-    const std::size_t count = 2 + static_cast<std::size_t>(round % 7);
-    std::vector<int> done(count, 0);  // written by one thread per index
-    pool.ParallelFor(count, 1, [&](std::size_t i) { done[i] = round + 1; });
-    for (std::size_t i = 0; i < count; ++i) ASSERT_EQ(done[i], round + 1) << round << " " << i;
+  for (int round = 0; round < 200; ++round) {
+    std::vector<std::atomic<int>> calls(3);
+    pool.RunOnAll([&](int thread) { calls[static_cast<std::size_t>(thread)].fetch_add(1); });
+    // RunOnAll has returned, so every call has.
+    for (int thread = 0; thread < 3; ++thread) ASSERT_EQ(calls[thread].load(), 1);
   }
 }
 
