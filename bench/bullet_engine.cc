@@ -98,6 +98,7 @@ std::unique_ptr<Engine> MakeBulletEngine(const Scene& scene, const BulletSleep& 
 std::string EngineName(EngineKind kind) {
   switch (kind) {
     case EngineKind::kOurs:
+    case EngineKind::kOursTwoThreads:
       return "ours";
     case EngineKind::kBullet:
       return "bullet";
@@ -107,9 +108,16 @@ std::string EngineName(EngineKind kind) {
   return "";
 }
 
+int EngineThreads(EngineKind kind) { return kind == EngineKind::kOursTwoThreads ? 2 : 1; }
+
 std::unique_ptr<Engine> MakeEngine(EngineKind kind, const Scene& scene,
                                    const OurSettingsOverrides& overrides) {
   if (kind == EngineKind::kOurs) return MakeOurEngine(scene, overrides);
+  if (kind == EngineKind::kOursTwoThreads) {
+    OurSettingsOverrides two = overrides;
+    two.threads = 2;
+    return MakeOurEngine(scene, two);
+  }
   BulletSleep sleep;
   if (kind == EngineKind::kBulletOurSleep) {
     const physics::SleepSettings ours;

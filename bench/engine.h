@@ -69,13 +69,18 @@ struct OurSettingsOverrides {
   std::optional<double> time_to_sleep;       // s an island must stay slow before it sleeps, > 0
   std::optional<double> velocity_tolerance;  // m/s, the sweeps' early stop, >= 0
   std::optional<bool> interleave_independent_runs;  // the sweeps pair independent runs of rows
+  std::optional<int> threads;                       // WorldSettings::threads, [0, 256]
 };
 
-// The engines under test: ours; Bullet with its defaults; Bullet with the
-// sleep thresholds of ours (bullet_engine.cc). Bullet's multi-threaded world
-// is left out: Debian's build has no thread-safe Bullet (performance.md).
-enum class EngineKind { kOurs, kBullet, kBulletOurSleep };
+// The engines under test: ours on one thread; Bullet with its defaults;
+// Bullet with the sleep thresholds of ours (bullet_engine.cc); ours on two
+// threads. Bullet's multi-threaded world is left out: Debian's build has no
+// thread-safe Bullet (performance.md).
+enum class EngineKind { kOurs, kBullet, kBulletOurSleep, kOursTwoThreads };
+// "ours", "bullet" or "bullet_oursleep"; both of ours are "ours", told apart
+// by EngineThreads.
 std::string EngineName(EngineKind kind);
+int EngineThreads(EngineKind kind);
 
 // Bullet's sleeping: its defaults, or the thresholds of ours.
 struct BulletSleep {

@@ -251,6 +251,7 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
   Summary summary;
   summary.scene = scene.name;
   summary.engine = EngineName(kind);
+  summary.threads = EngineThreads(kind);
   summary.bodies = static_cast<int>(scene.bodies.size());
   for (const BenchArticulation& articulation : scene.articulations) {
     summary.bodies += static_cast<int>(articulation.links.size()) - 1;  // the moving links
@@ -298,12 +299,35 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
 
 }  // namespace
 
+std::string EngineLabel(const Summary& summary) {
+  return summary.threads > 1 ? summary.engine + " x" + std::to_string(summary.threads)
+                             : summary.engine;
+}
+
+namespace {
+
+// Appends this run's ms per step and per awake step of engine `mine` over
+// engine `other`'s, where both ran and measured them.
+void AddRatios(const RunResult& mine, const RunResult& other, std::vector<double>* ratios,
+               std::vector<double>* awake_ratios) {
+  if (other.step_ms > 0.0) ratios->push_back(mine.step_ms / other.step_ms);
+  if (AwakeStepMs(mine) > 0.0 && AwakeStepMs(other) > 0.0) {
+    awake_ratios->push_back(AwakeStepMs(mine) / AwakeStepMs(other));
+  }
+}
+
+}  // namespace
+
 std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSettings& settings,
                                     const std::vector<EngineKind>& engines) {
   const std::size_t count = engines.size();
   std::vector<std::vector<RunResult>> results(count);
   std::vector<std::vector<double>> ratios(count);
   std::vector<std::vector<double>> awake_ratios(count);
+  std::vector<std::vector<double>> two_ratios(count);
+  std::vector<std::vector<double>> two_awake_ratios(count);
+  const std::size_t two = static_cast<std::size_t>(
+      std::find(engines.begin(), engines.end(), EngineKind::kOursTwoThreads) - engines.begin());
   for (int run = 0; run < runs; ++run) {
     const Scene jittered = JitterScene(scene, run);
     std::vector<RunResult> this_run(count);
@@ -319,11 +343,12 @@ std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSetti
     }
     // Ours is engines[0]: its ratio to each other engine in this run.
     for (std::size_t e = 1; e < count && ok[0]; ++e) {
-      if (!ok[e]) continue;
-      if (this_run[e].step_ms > 0.0) ratios[e].push_back(this_run[0].step_ms / this_run[e].step_ms);
-      if (AwakeStepMs(this_run[0]) > 0.0 && AwakeStepMs(this_run[e]) > 0.0) {
-        awake_ratios[e].push_back(AwakeStepMs(this_run[0]) / AwakeStepMs(this_run[e]));
-      }
+      if (ok[e]) AddRatios(this_run[0], this_run[e], &ratios[e], &awake_ratios[e]);
+    }
+    // Ours on two threads, when among them: its ratio to each other engine.
+    for (std::size_t e = 0; e < count && two < count && ok[two]; ++e) {
+      if (ok[e] && e != two)
+        AddRatios(this_run[two], this_run[e], &two_ratios[e], &two_awake_ratios[e]);
     }
   }
   std::vector<Summary> summaries;
@@ -331,6 +356,8 @@ std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSetti
     summaries.push_back(Summarize(scene, engines[e], std::move(results[e])));
     summaries.back().ours_over_this = Median(std::move(ratios[e]));
     summaries.back().ours_over_this_awake = Median(std::move(awake_ratios[e]));
+    summaries.back().ours2_over_this = Median(std::move(two_ratios[e]));
+    summaries.back().ours2_over_this_awake = Median(std::move(two_awake_ratios[e]));
   }
   return summaries;
 }

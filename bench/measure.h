@@ -83,7 +83,13 @@ struct Summary {
   // to back (MeasureEngines); 0 when not measured.
   double ours_over_this = 0.0;
   double ours_over_this_awake = 0.0;
+  // The same for ours on two threads over this engine, when it ran.
+  double ours2_over_this = 0.0;
+  double ours2_over_this_awake = 0.0;
 };
+
+// The engine's name, with its threads when more than one ("ours x2").
+std::string EngineLabel(const Summary& summary);
 
 // How every run of a benchmark is made.
 struct RunSettings {

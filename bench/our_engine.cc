@@ -99,6 +99,7 @@ class OurEngine : public Engine {
     solver.interleave_independent_runs =
         overrides.interleave_independent_runs.value_or(solver.interleave_independent_runs);
     settings.sleep.time_to_sleep = overrides.time_to_sleep.value_or(settings.sleep.time_to_sleep);
+    settings.threads = overrides.threads.value_or(settings.threads);
     assert(physics::ValidateWorldSettings(settings).ok());
     world_ = std::make_unique<physics::World>(settings);
 

@@ -173,6 +173,7 @@ void PrintHeader(const Options& options, double window_seconds) {
       "awake ms: ms per step over the steps with every moving body awake (median over the "
       "runs); ours/it, awake: ours over that engine, ms per step and ms per awake step, the "
       "median of the runs' ratios; bullet_oursleep: Bullet with our sleep thresholds and time; "
+      "ours x2: ours on two threads (its ours/it: ours on one thread over it); "
       "chain and arm: Bullet's btMultiBody\n",
       options.runs);
   std::printf(
@@ -188,7 +189,8 @@ void PrintHeader(const Options& options, double window_seconds) {
 Rows MeasureScenes(const Options& options, const std::vector<Scene>& scenes,
                    double window_seconds) {
   const std::vector<EngineKind> engines = {EngineKind::kOurs, EngineKind::kBullet,
-                                           EngineKind::kBulletOurSleep};
+                                           EngineKind::kBulletOurSleep,
+                                           EngineKind::kOursTwoThreads};
   Rows rows;
   for (const Scene& scene : scenes) {
     const int runs = IsLarge(scene) ? options.large_runs : options.runs;

@@ -131,7 +131,7 @@ void PrintSceneRows(const Scene& scene, const std::vector<Summary>& summaries) {
     const Quality quality = SceneQuality(scene, summary.median);
     std::printf(
         "%-12s %-15s %6d %6.2f %9.3f [%7.3f,%7.3f] %9.3f %8s %8s %9.3g %9.2f %11.2f %7.1f  %s\n",
-        scene.name.c_str(), summary.engine.c_str(), summary.bodies, summary.seconds,
+        scene.name.c_str(), EngineLabel(summary).c_str(), summary.bodies, summary.seconds,
         summary.ms_median, summary.ms_min, summary.ms_max, summary.awake_ms_median,
         Ratio(summary.ours_over_this).c_str(), Ratio(summary.ours_over_this_awake).c_str(),
         summary.median.final_kinetic_energy, 1e3 * summary.median.final_penetration,
@@ -157,7 +157,7 @@ void PrintStageProfile(const Rows& rows) {
     for (const Summary& summary : scene_rows) {
       const RunResult& result = summary.median;
       std::printf("%-12s %-15s %9.3f %9.3f %9.3f %9.3f %13.1f %10.2f %16.3f %8.2f\n",
-                  summary.scene.c_str(), summary.engine.c_str(), result.broad_phase_ms,
+                  summary.scene.c_str(), EngineLabel(summary).c_str(), result.broad_phase_ms,
                   result.narrow_phase_ms, result.solver_ms, result.integrator_ms, RowCostNs(result),
                   result.contact_steps * kTimeStep, ContactStepMs(result),
                   result.awake_steps * kTimeStep);
@@ -215,7 +215,8 @@ const std::vector<std::string>& CsvColumns() {
       "max_penetration_m", "top_drift_m",
       // The rest of the report.
       "bodies", "sim_seconds", "ms_per_step_min", "ms_per_step_max", "steps_per_second",
-      "ours_over_this_ms_per_step", "ours_over_this_ms_per_awake_step", "awake_seconds",
+      "ours_over_this_ms_per_step", "ours_over_this_ms_per_awake_step",
+      "ours2_over_this_ms_per_step", "ours2_over_this_ms_per_awake_step", "awake_seconds",
       "final_kinetic_energy_j", "final_penetration_m", "bounce_apex_m", "bounce_apex_error",
       "incline_slide_m", "incline_error", "joint_separation_m", "boxes_moved",
       "driven_joint_swept_rad", "driven_joint_commanded_rad", "broad_phase_ms", "narrow_phase_ms",
@@ -265,6 +266,12 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
       }
       if (summary.ours_over_this_awake > 0.0) {
         values["ours_over_this_ms_per_awake_step"] = Number(summary.ours_over_this_awake);
+      }
+      if (summary.ours2_over_this > 0.0) {
+        values["ours2_over_this_ms_per_step"] = Number(summary.ours2_over_this);
+      }
+      if (summary.ours2_over_this_awake > 0.0) {
+        values["ours2_over_this_ms_per_awake_step"] = Number(summary.ours2_over_this_awake);
       }
       const Quality quality = SceneQuality(scene, result);
       switch (scene.kind) {

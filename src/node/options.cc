@@ -274,6 +274,10 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     return Status::Error("~max_file_bytes " + std::to_string(options.max_file_bytes) +
                          " must be >= 1");
   }
+  if (Status status = CheckRange("~threads", options.world.threads, 0, physics::kMaxThreads, "");
+      !status.ok()) {
+    return status;
+  }
   if (Status status = physics::ValidateWorldSettings(options.world); !status.ok()) {
     return Status::Error(
         "world settings (~gravity, ~time_step, ~contact_margin, "
@@ -361,6 +365,7 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"max_hull_vertices", &options->max_hull_vertices},
       {"contact_margin", &world.contact_margin},
       {"contact_reuse_distance", &world.contact_reuse_distance},
+      {"threads", &world.threads},
       {"continuous_fraction", &world.continuous_fraction},
       {"solver/velocity_iterations", &solver.velocity_iterations},
       {"solver/velocity_tolerance", &solver.velocity_tolerance},

@@ -31,6 +31,8 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
   // Sized, not cleared: World loads the bodies the contacts reach.
   bodies_.resize(body_count);
   manifolds_.clear();
+  schedules_.resize(1);
+  schedules_.front().clear();
 }
 
 void ContactSolver::Prepare() {

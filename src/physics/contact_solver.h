@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "physics/contact_manifold.h"
+#include "physics/task_pool.h"
 #include "physics/union_find.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/types.h"
@@ -108,6 +109,14 @@ struct SweepTask {
   std::uint32_t second_end = 0;
   std::uint32_t first_island = 0;
   std::uint32_t second_island = 0;
+  // Which of the four bodies the solve moves (kFirstA ...): only those are
+  // stored back, so that two threads sweeping rows on the same static body
+  // never write it.
+  std::uint8_t moving = 0;
+  static constexpr std::uint8_t kFirstA = 1;
+  static constexpr std::uint8_t kFirstB = 2;
+  static constexpr std::uint8_t kSecondA = 4;
+  static constexpr std::uint8_t kSecondB = 8;
 };
 
 // One island of the resting solve, a connected component of its rows
@@ -124,6 +133,8 @@ class ContactSolver {
  public:
   // Starts a new step: keeps the arrays' memory, clears their contents.
   void Reset(const SolverSettings& settings, double time_step, std::size_t body_count);
+  // The threads the resting solve shares its islands among (none: one).
+  void set_pool(TaskPool* pool) { pool_ = pool; }
 
   std::vector<SolverBody>& bodies() { return bodies_; }
   std::vector<SolverManifold>& manifolds() { return manifolds_; }
@@ -171,6 +182,8 @@ class ContactSolver {
   int velocity_sweeps() const { return velocity_sweeps_; }
   // Row updates of those sweeps: each island's rows times its sweeps.
   std::size_t velocity_row_updates() const { return velocity_row_updates_; }
+  // Groups of islands the last SolveRestingContacts swept, one per thread.
+  int island_groups() const { return static_cast<int>(schedules_.size()); }
 
  private:
   void ApplyImpulse(const SolverManifold& manifold, const SolverPoint& point,
@@ -179,10 +192,15 @@ class ContactSolver {
   Vec3 RelativeVelocity(const SolverManifold& manifold, const SolverPoint& point) const;
   void BuildRestingRows();
   void FindIslands();
+  // Shares the islands among the threads (island_group_), fewest rows first.
+  void GroupIslands();
   void ScheduleRuns();
   template <bool kPseudo>
-  void SweepSchedule();
+  void SweepSchedule(const std::vector<SweepTask>& schedule);
   void SweepUntilConverged();
+  // SweepUntilConverged for one group's islands; returns its sweeps and adds
+  // its row updates to *row_updates.
+  int SweepGroupUntilConverged(std::size_t group, std::size_t* row_updates);
   // Returns whether it finished any island, which it then marks unconverged.
   bool FinishIslandsExactly();
   void ComputeMasses();
@@ -203,7 +221,14 @@ class ContactSolver {
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
   std::vector<RestingRow> rows_;
-  std::vector<SweepTask> schedule_;
+  TaskPool* pool_ = nullptr;
+  // One schedule per group of islands, each swept by one thread; a single
+  // group (one thread, or one island) is the reference order.
+  std::vector<std::vector<SweepTask>> schedules_;
+  std::vector<std::uint32_t> island_group_;  // per island, its group
+  // Per group, the tasks of its schedule with a row penetrating beyond the
+  // slop: the only ones the split impulse's sweeps change anything in.
+  std::vector<std::vector<SweepTask>> pseudo_schedules_;
   std::vector<RestingIsland> islands_;
   // Each row's island; with the rest, scratch of FindIslands kept for its
   // memory.

@@ -10,10 +10,30 @@
 #include "physics/resting_row.h"
 
 namespace rigid_body_sim::physics {
+namespace {
+
+// Calls run(group) for each group, on the pool's threads when there are
+// several groups (at most one per thread), else on the caller's.
+template <typename Run>
+void RunGroups(TaskPool* pool, std::size_t group_count, const Run& run) {
+  if (group_count == 1 || pool == nullptr) {
+    for (std::size_t group = 0; group < group_count; ++group) run(group);
+    return;
+  }
+  const auto threads = static_cast<std::size_t>(pool->threads());
+  pool->RunOnAll([&](int thread) {
+    for (auto group = static_cast<std::size_t>(thread); group < group_count; group += threads) {
+      run(group);
+    }
+  });
+}
+
+}  // namespace
 
 void ContactSolver::SolveRestingContacts() {
   BuildRestingRows();
   FindIslands();
+  GroupIslands();
   ScheduleRuns();
   for (const RestingRow& row : rows_) {
     ApplyRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]),
@@ -29,10 +49,30 @@ void ContactSolver::SolveRestingContacts() {
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
   // without touching the real velocities, so no energy is added. The same
-  // schedule, every island.
-  for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
-    SweepSchedule</*kPseudo=*/true>();
-  }
+  // schedules, every island, each group on its thread; a task none of whose
+  // rows penetrates beyond the slop is left out, as its updates change
+  // nothing (UpdatePseudoRow returns at once), so the result is the same
+  // bit for bit while a settled pile's sweeps skip most rows.
+  pseudo_schedules_.resize(schedules_.size());
+  auto penetrates = [this](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t r = begin; r < end; ++r) {
+      if (rows_[r].depth > 0.0) return true;
+    }
+    return false;
+  };
+  RunGroups(pool_, schedules_.size(), [&](std::size_t group) {
+    std::vector<SweepTask>& pseudo = pseudo_schedules_[group];
+    pseudo.clear();
+    for (const SweepTask& task : schedules_[group]) {
+      if (penetrates(task.first_begin, task.first_end) ||
+          penetrates(task.second_begin, task.second_end)) {
+        pseudo.push_back(task);
+      }
+    }
+    for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
+      SweepSchedule</*kPseudo=*/true>(pseudo);
+    }
+  });
   for (const RestingRow& row : rows_) {
     row.point->normal_impulse = row.normal_impulse;
     row.point->tangent_impulse = row.tangent_impulse;
@@ -109,15 +149,16 @@ void ContactSolver::BuildRestingRows() {
 // pseudo velocities, over every island. Flattened: with any update left a
 // call, a run's velocities stay in memory and the sweep takes 30 % longer.
 template <bool kPseudo>
-[[gnu::flatten]] void ContactSolver::SweepSchedule() {
+[[gnu::flatten]] void ContactSolver::SweepSchedule(const std::vector<SweepTask>& schedule) {
   const double correction = settings_.position_correction;
   const double inverse_dt = 1.0 / time_step_;
-  for (const SweepTask& task : schedule_) {
+  for (const SweepTask& task : schedule) {
     std::uint32_t first_begin = task.first_begin;
     std::uint32_t first_end = task.first_end;
     std::uint32_t first_island = task.first_island;
     std::uint32_t second_begin = task.second_begin;
     std::uint32_t second_end = task.second_end;
+    std::uint8_t moving = task.moving;
     if constexpr (!kPseudo) {
       if (islands_[task.second_island].converged) second_end = second_begin;
       if (islands_[first_island].converged) {
@@ -125,6 +166,7 @@ template <bool kPseudo>
         first_end = second_end;
         first_island = task.second_island;
         second_end = second_begin;
+        moving >>= 2;
       }
       if (first_begin == first_end) continue;
     }
@@ -153,8 +195,14 @@ template <bool kPseudo>
                      UpdateRow<kPseudo>(correction, inverse_dt, &rows_[s++], &second));
       }
     }
-    if (paired) StoreRun<kPseudo>(second, &second_a, &second_b);
-    StoreRun<kPseudo>(first, &first_a, &first_b);
+    // A body the solve does not move keeps its velocity (its inverse mass
+    // and inertia are zero), so it is not stored.
+    if (paired) {
+      StoreRun<kPseudo>(second, (moving & SweepTask::kSecondA) ? &second_a : nullptr,
+                        (moving & SweepTask::kSecondB) ? &second_b : nullptr);
+    }
+    StoreRun<kPseudo>(first, (moving & SweepTask::kFirstA) ? &first_a : nullptr,
+                      (moving & SweepTask::kFirstB) ? &first_b : nullptr);
     if constexpr (!kPseudo) {
       double& first_largest = islands_[first_island].largest_change_squared;
       first_largest = std::max(first_largest, first_change_squared);
@@ -171,18 +219,34 @@ template <bool kPseudo>
 // sweeping once none of its points' relative velocities changed by more
 // than velocity_tolerance since the previous sweep: its motion has
 // converged, even where the impulses of redundant points (four corners where
-// three would carry the load) still trade load between them.
+// three would carry the load) still trade load between them. Each group of
+// islands sweeps on its own thread; an island's sweeps are the same in any
+// group, so the count of the slowest is the same as with one.
 void ContactSolver::SweepUntilConverged() {
+  const std::size_t group_count = schedules_.size();
+  std::vector<int> sweeps(group_count, 0);
+  std::vector<std::size_t> row_updates(group_count, 0);
+  RunGroups(pool_, group_count, [&](std::size_t group) {
+    sweeps[group] = SweepGroupUntilConverged(group, &row_updates[group]);
+  });
+  velocity_sweeps_ += *std::max_element(sweeps.begin(), sweeps.end());
+  for (const std::size_t updates : row_updates) velocity_row_updates_ += updates;
+}
+
+int ContactSolver::SweepGroupUntilConverged(std::size_t group, std::size_t* row_updates) {
   const double tolerance_squared = settings_.velocity_tolerance * settings_.velocity_tolerance;
   std::size_t sweeping = 0;
-  for (const RestingIsland& island : islands_) sweeping += !island.converged;
+  for (std::uint32_t island = 0; island < islands_.size(); ++island) {
+    sweeping += island_group_[island] == group && !islands_[island].converged;
+  }
   int sweeps = 0;
   while (sweeping > 0 && sweeps < settings_.velocity_iterations) {
-    SweepSchedule</*kPseudo=*/false>();
+    SweepSchedule</*kPseudo=*/false>(schedules_[group]);
     ++sweeps;
-    for (RestingIsland& island : islands_) {
-      if (island.converged) continue;
-      velocity_row_updates_ += island.row_count;
+    for (std::uint32_t index = 0; index < islands_.size(); ++index) {
+      RestingIsland& island = islands_[index];
+      if (island_group_[index] != group || island.converged) continue;
+      *row_updates += island.row_count;
       // The first sweep has no sweep before it to compare with.
       if (sweeps > 1 && island.largest_change_squared <= tolerance_squared) {
         island.converged = true;
@@ -191,7 +255,7 @@ void ContactSolver::SweepUntilConverged() {
       island.largest_change_squared = 0.0;
     }
   }
-  velocity_sweeps_ += sweeps;
+  return sweeps;
 }
 
 }  // namespace rigid_body_sim::physics

@@ -58,6 +58,8 @@ double NormalResponse(const RestingRow& row_i, const RestingRow& row_k) {
 // result (a third chain measured no faster). Greedy, in manifold order: each
 // run not yet scheduled takes the first of the next kPartnerWindow such runs
 // that shares no moving body with it nor with the runs it would pass.
+// Each group of islands (GroupIslands) gets its own schedule of its own
+// runs, in the same manifold order; with one group this is the whole sweep.
 void ContactSolver::ScheduleRuns() {
   struct Run {
     std::uint32_t begin;
@@ -74,7 +76,11 @@ void ContactSolver::ScheduleRuns() {
     while (r < rows_.size() && rows_[r].body_a == a && rows_[r].body_b == b) ++r;
     runs.push_back({begin, r, {moving(a), moving(b)}, false});
   }
-  schedule_.clear();
+  const std::size_t group_count = schedules_.size();
+  std::vector<std::vector<std::uint32_t>> group_runs(group_count);
+  for (std::uint32_t i = 0; i < runs.size(); ++i) {
+    group_runs[island_group_[row_island_[runs[i].begin]]].push_back(i);
+  }
   std::vector<std::uint32_t> blocked;
   auto is_blocked = [&](const Run& run) {
     for (const std::uint32_t body : run.moving) {
@@ -84,29 +90,65 @@ void ContactSolver::ScheduleRuns() {
     }
     return false;
   };
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    if (runs[i].scheduled) continue;
-    runs[i].scheduled = true;
-    SweepTask& task = schedule_.emplace_back();
-    task.first_begin = runs[i].begin;
-    task.first_end = runs[i].end;
-    task.second_begin = task.second_end = runs[i].end;
-    task.first_island = task.second_island = row_island_[runs[i].begin];
-    blocked.assign(runs[i].moving.begin(), runs[i].moving.end());
-    const int window = settings_.interleave_independent_runs ? kPartnerWindow : 0;
-    int looked = 0;
-    for (std::size_t j = i + 1; j < runs.size() && looked < window; ++j) {
-      if (runs[j].scheduled) continue;
-      ++looked;
-      if (!is_blocked(runs[j])) {
-        runs[j].scheduled = true;
-        task.second_begin = runs[j].begin;
-        task.second_end = runs[j].end;
-        task.second_island = row_island_[runs[j].begin];
-        break;
+  auto moving_bits = [](const Run& run, std::uint8_t bit_a, std::uint8_t bit_b) {
+    return static_cast<std::uint8_t>((run.moving[0] != kFixedBody ? bit_a : 0) |
+                                     (run.moving[1] != kFixedBody ? bit_b : 0));
+  };
+  for (std::size_t group = 0; group < group_count; ++group) {
+    const std::vector<std::uint32_t>& order = group_runs[group];
+    std::vector<SweepTask>& schedule = schedules_[group];
+    schedule.clear();
+    for (std::size_t n = 0; n < order.size(); ++n) {
+      Run& run = runs[order[n]];
+      if (run.scheduled) continue;
+      run.scheduled = true;
+      SweepTask& task = schedule.emplace_back();
+      task.first_begin = run.begin;
+      task.first_end = run.end;
+      task.second_begin = task.second_end = run.end;
+      task.first_island = task.second_island = row_island_[run.begin];
+      task.moving = moving_bits(run, SweepTask::kFirstA, SweepTask::kFirstB);
+      blocked.assign(run.moving.begin(), run.moving.end());
+      const int window = settings_.interleave_independent_runs ? kPartnerWindow : 0;
+      int looked = 0;
+      for (std::size_t m = n + 1; m < order.size() && looked < window; ++m) {
+        Run& partner = runs[order[m]];
+        if (partner.scheduled) continue;
+        ++looked;
+        if (!is_blocked(partner)) {
+          partner.scheduled = true;
+          task.second_begin = partner.begin;
+          task.second_end = partner.end;
+          task.second_island = row_island_[partner.begin];
+          task.moving |= moving_bits(partner, SweepTask::kSecondA, SweepTask::kSecondB);
+          break;
+        }
+        blocked.insert(blocked.end(), partner.moving.begin(), partner.moving.end());
       }
-      blocked.insert(blocked.end(), runs[j].moving.begin(), runs[j].moving.end());
     }
+  }
+}
+
+// Islands share no body the solve moves, so each may be swept by its own
+// thread: a group of islands per thread, the islands in order each to the
+// group with the fewest rows so far (ties to the lowest group), which
+// depends on the rows only. One group unless there are threads, two islands
+// and rows enough to pay for waking the threads.
+void ContactSolver::GroupIslands() {
+  constexpr std::size_t kMinRowsToShare = 256;
+  std::size_t group_count = 1;
+  if (pool_ != nullptr && islands_.size() > 1 && rows_.size() >= kMinRowsToShare) {
+    group_count = std::min(static_cast<std::size_t>(pool_->threads()), islands_.size());
+  }
+  schedules_.resize(group_count);
+  island_group_.assign(islands_.size(), 0);
+  if (group_count == 1) return;
+  std::vector<std::size_t> rows_in_group(group_count, 0);
+  for (std::uint32_t island = 0; island < islands_.size(); ++island) {
+    const std::size_t group = static_cast<std::size_t>(
+        std::min_element(rows_in_group.begin(), rows_in_group.end()) - rows_in_group.begin());
+    island_group_[island] = static_cast<std::uint32_t>(group);
+    rows_in_group[group] += islands_[island].row_count;
   }
 }
 

@@ -48,18 +48,28 @@ RunVelocities LoadRun(const SolverBody& a, const SolverBody& b) {
   }
 }
 
+// Stores the run's velocities into the bodies given; a null body is left
+// as it is.
 template <bool kPseudo>
 void StoreRun(const RunVelocities& velocities, SolverBody* a, SolverBody* b) {
   if constexpr (kPseudo) {
-    a->pseudo_linear_velocity = velocities.linear_a;
-    a->pseudo_angular_velocity = velocities.angular_a;
-    b->pseudo_linear_velocity = velocities.linear_b;
-    b->pseudo_angular_velocity = velocities.angular_b;
+    if (a != nullptr) {
+      a->pseudo_linear_velocity = velocities.linear_a;
+      a->pseudo_angular_velocity = velocities.angular_a;
+    }
+    if (b != nullptr) {
+      b->pseudo_linear_velocity = velocities.linear_b;
+      b->pseudo_angular_velocity = velocities.angular_b;
+    }
   } else {
-    a->linear_velocity = velocities.linear_a;
-    a->angular_velocity = velocities.angular_a;
-    b->linear_velocity = velocities.linear_b;
-    b->angular_velocity = velocities.angular_b;
+    if (a != nullptr) {
+      a->linear_velocity = velocities.linear_a;
+      a->angular_velocity = velocities.angular_a;
+    }
+    if (b != nullptr) {
+      b->linear_velocity = velocities.linear_b;
+      b->angular_velocity = velocities.angular_b;
+    }
   }
 }
 

@@ -199,21 +199,32 @@ void WorldImpl::BoundBodyMotion(double dt) {
 // Candidate pairs: a pair with no touching point at the start (a new
 // contact, which the solver has not seen), and every pair of a fast body;
 // pairs already touching are the resting solver's.
+// Each pair's search reads the bodies and their paths and writes only its
+// own entry, so the pairs are searched on the pool, and the impacts listed
+// afterwards in the pairs' order: the same list for any number of threads.
 std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs) {
-  std::vector<Impact> impacts;
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
+  // A pair's search costs 0.1-10 us; a chunk this long amortizes taking it.
+  constexpr std::size_t kPairsPerChunk = 64;
+  impact_searches_.resize(pairs.size());
+  pool_->ParallelFor(pairs.size(), kPairsPerChunk, [&](std::size_t e) {
     PrefetchAhead(pairs, e, PrefetchManifold);
     ShapePairContact* pair = pairs[e];
-    if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) continue;
+    ImpactSearch& search = impact_searches_[e];
+    search.time = std::numeric_limits<double>::infinity();
+    if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) return;
     // A link's contacts are the articulation solve's, which lets no point
     // close more than its gap within a step.
-    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0)
-      continue;
-    double approach_speed = 0.0;
-    const double time = PairImpactTime(dt, pair, &approach_speed);
-    if (!std::isfinite(time)) continue;
-    const bool colliding = approach_speed > settings_.solver.collision_velocity_threshold;
-    impacts.push_back(Impact{pair, time, colliding});
+    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0) {
+      return;
+    }
+    search.time = PairImpactTime(dt, pair, &search.approach_speed);
+  });
+  std::vector<Impact> impacts;
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const ImpactSearch& search = impact_searches_[e];
+    if (!std::isfinite(search.time)) continue;
+    const bool colliding = search.approach_speed > settings_.solver.collision_velocity_threshold;
+    impacts.push_back(Impact{pairs[e], search.time, colliding});
   }
   return impacts;
 }

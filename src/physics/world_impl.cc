@@ -82,13 +82,31 @@ void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
   body->start_angular_momentum = body->angular_momentum;
 }
 
-WorldImpl::WorldImpl(const WorldSettings& settings) : settings_(settings) {
+namespace {
+
+// A pool of the threads `settings` ask for; out-of-range counts (refused by
+// ValidateWorldSettings, reaching here only with asserts off) clamp.
+std::unique_ptr<TaskPool> MakePool(const WorldSettings& settings) {
+  return std::make_unique<TaskPool>(
+      std::clamp(ResolveThreadCount(settings.threads), 1, kMaxThreads));
+}
+
+}  // namespace
+
+WorldImpl::WorldImpl(const WorldSettings& settings)
+    : settings_(settings), pool_(MakePool(settings)) {
   assert(ValidateWorldSettings(settings).ok());
+  solver_.set_pool(pool_.get());
 }
 
 Status WorldImpl::SetSettings(const WorldSettings& settings) {
   Status status = ValidateWorldSettings(settings);
-  if (status.ok()) settings_ = settings;
+  if (!status.ok()) return status;
+  if (ResolveThreadCount(settings.threads) != pool_->threads()) {
+    pool_ = MakePool(settings);
+    solver_.set_pool(pool_.get());
+  }
+  settings_ = settings;
   return status;
 }
 
@@ -342,6 +360,7 @@ void WorldImpl::Step() {
   }
   profile.velocity_sweeps = solver_.velocity_sweeps();
   profile.velocity_row_updates = solver_.velocity_row_updates();
+  profile.island_groups = solver_.island_groups();
   time_ += dt;
 }
 

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "physics/articulation_dynamics.h"
@@ -16,6 +17,7 @@
 #include "physics/contact_cache.h"
 #include "physics/contact_solver.h"
 #include "physics/integrator.h"
+#include "physics/task_pool.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
@@ -30,6 +32,16 @@ struct Impact {
   ShapePairContact* pair = nullptr;
   double time = 0.0;       // s from the (sub)step's start
   bool colliding = false;  // the surfaces meet faster than collision_velocity_threshold
+};
+
+// A shape pair the narrow phase tests this step (stage 2): its cache entry,
+// which holds the bodies, shapes and contact distance, and the summed travel
+// of the two bodies (Body::travel). Jobs write only their own entry, so any
+// thread may run any of them.
+struct NarrowJob {
+  ShapePairContact* entry = nullptr;
+  double travel = 0.0;  // m
+  bool reused = false;  // the manifold was carried, not clipped (out)
 };
 
 // Refuses a non-finite pose or velocity, or a quaternion not of unit length.
@@ -125,7 +137,11 @@ class WorldImpl {
   void RecollidePair(double h, ShapePairContact* pair);
   int PathSamples(std::uint32_t body_a, std::uint32_t body_b) const;
   double PairThickness(const ShapePairContact& pair) const;
+  // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
+  // a static mesh's are tested at once.
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  // Tests one listed shape pair: carries its manifold or clips a new one.
+  void CollideShapePair(NarrowJob* job) const;
   double ContactDistance(const Body& a, const Body& b, double dt) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
@@ -162,6 +178,15 @@ class WorldImpl {
   void MoveArticulations(double dt);
 
   WorldSettings settings_;
+  std::unique_ptr<TaskPool> pool_;      // settings_.threads threads
+  std::vector<NarrowJob> narrow_jobs_;  // stage 2's, in the order the pairs were visited
+  // FindImpacts' per pair: the time of impact (s, +infinity for none) and
+  // the speed the surfaces meet at (m/s).
+  struct ImpactSearch {
+    double time = 0.0;
+    double approach_speed = 0.0;
+  };
+  std::vector<ImpactSearch> impact_searches_;
   std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;

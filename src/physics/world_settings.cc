@@ -76,6 +76,10 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
                               " rad/s must be >= 0"),
           FiniteAbove("sleep.time_to_sleep", sleep.time_to_sleep, 0.0, false,
                       "finite and >= 0 (s)"),
+          settings.threads >= 0 && settings.threads <= kMaxThreads
+              ? Status::Ok()
+              : Status::Error("threads " + std::to_string(settings.threads) + " must be in [0, " +
+                              std::to_string(kMaxThreads) + "] (0: one per core)"),
           FiniteAbove("sleep.speeding_up_time", sleep.speeding_up_time, 0.0, false,
                       "finite and >= 0 (s)"),
       });

@@ -34,6 +34,19 @@ TEST(OptionsTest, BadValuesAreNamed) {
   options.servo.damping = -1.0;
   EXPECT_EQ(ValidateNodeOptions(options).message(),
             "~joint_damping -1 is outside the allowed range [0, 1e12] N m s/rad");
+  options = NodeOptions();
+  options.world.threads = -1;
+  EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads -1 is outside [0, 256]");
+  options.world.threads = 257;
+  EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads 257 is outside [0, 256]");
+}
+
+// ~threads defaults to every core (0); 2 is valid.
+TEST(OptionsTest, ThreadsDefaultToEveryCore) {
+  NodeOptions options;
+  EXPECT_EQ(options.world.threads, 0);
+  options.world.threads = 2;
+  EXPECT_TRUE(ValidateNodeOptions(options).ok());
 }
 
 TEST(OptionsTest, LiveRangesHoldAtStartUpAndWarnAboveAThirtiethOfASecond) {

@@ -7,7 +7,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,6 +15,7 @@
 #include "rigid_body_sim/physics/types.h"
 #include "rigid_body_sim/physics/world.h"
 #include "scene.h"
+#include "state_hash.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -26,34 +26,11 @@ using testing::AddSphere;
 using testing::BoxSpec;
 using testing::MakeMaterial;
 using testing::SphereSpec;
+using testing::StateHash;
 using testing::Translation;
 
 constexpr int kSteps = 1000;
 constexpr int kMidSteps = 500;
-
-// FNV-1a, 64 bits, over the bytes of doubles: a change in the last bit of
-// any value changes the hash, which a sum or a norm of the state would not
-// reliably do.
-class StateHash {
- public:
-  void Add(double value) {
-    unsigned char bytes[sizeof(double)];
-    std::memcpy(bytes, &value, sizeof(double));
-    for (const unsigned char byte : bytes) {
-      hash_ ^= byte;
-      hash_ *= kPrime;
-    }
-  }
-  void Add(const Vec3& v) {
-    for (int i = 0; i < 3; ++i) Add(v[i]);
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  static constexpr std::uint64_t kOffsetBasis = 14695981039346656037ULL;
-  static constexpr std::uint64_t kPrime = 1099511628211ULL;
-  std::uint64_t hash_ = kOffsetBasis;
-};
 
 // A body as it was spawned, so that it can be put back there.
 struct Spawn {

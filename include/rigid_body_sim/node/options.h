@@ -16,6 +16,13 @@
 
 namespace rigid_body_sim::node {
 
+// The node's defaults of the world settings: the core's, on every core.
+inline physics::WorldSettings NodeWorldSettings() {
+  physics::WorldSettings world;
+  world.threads = 0;
+  return world;
+}
+
 struct NodeOptions {
   std::string world_frame = "world";  // ~world_frame: parent of every body frame
   // ~gravity [x, y, z] (m/s^2, default [0, 0, -9.81]), ~time_step (s, > 0,
@@ -29,8 +36,10 @@ struct NodeOptions {
   // max_pivoting_points (count, 32)} and
   // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
   // (rad/s, 0.1), time_to_sleep (s, 0.5), speeding_up_time (s, 0.2)}; see
-  // physics/world_settings.h.
-  physics::WorldSettings world;
+  // physics/world_settings.h. ~threads (count, [0, 256], default 0: one
+  // per core) is the threads a step runs on; any count gives the same
+  // motion bit for bit.
+  physics::WorldSettings world = NodeWorldSettings();
   double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
   double publish_rate = 50.0;       // ~publish_rate: Hz of /tf, ~states, ~contacts, > 0
   bool paused = false;              // ~paused: start without stepping

@@ -67,6 +67,9 @@ struct SleepSettings {
   double speeding_up_time = 0.2;
 };
 
+// The most threads WorldSettings::threads may ask for.
+constexpr int kMaxThreads = 256;
+
 struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
   double time_step = 1.0 / 240.0;        // s, > 0
@@ -81,6 +84,12 @@ struct WorldSettings {
   // instead of clipped again while their relative motion since it was
   // clipped moves no point by more than this (0: clip every step).
   double contact_reuse_distance = 1e-3;
+  // Threads a step runs on, the caller's included, in [0, kMaxThreads]; 0:
+  // one per core. The narrow phase's shape pairs and the resting solve's
+  // islands are shared among them; every island is swept exactly as with
+  // one thread, so the result is the same bit for bit for any count. 1 (the
+  // default) starts no thread and is the reference path.
+  int threads = 1;
   SolverSettings solver;
   SleepSettings sleep;
 };
@@ -98,6 +107,9 @@ struct StepProfile {
   std::size_t solver_points = 0;  // contact points handed to the solver
   int velocity_sweeps = 0;        // Gauss-Seidel sweeps of the resting solve's slowest island
   std::size_t velocity_row_updates = 0;  // row updates of those sweeps, all islands
+  // Groups of islands the resting solve swept on threads of their own (1:
+  // all on the caller's thread).
+  int island_groups = 1;
   // Manifolds carried to the new poses (contact_reuse_distance) instead of
   // clipped, in stage 2.
   std::size_t reused_manifolds = 0;
