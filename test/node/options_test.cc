@@ -41,10 +41,12 @@ TEST(OptionsTest, BadValuesAreNamed) {
   EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads 257 is outside [0, 256]");
 }
 
-// ~threads defaults to every core (0); 2 is valid.
-TEST(OptionsTest, ThreadsDefaultToEveryCore) {
+// ~threads defaults to one thread; 0 (every core) and 2 are valid.
+TEST(OptionsTest, ThreadsDefaultToOne) {
   NodeOptions options;
-  EXPECT_EQ(options.world.threads, 0);
+  EXPECT_EQ(options.world.threads, 1);
+  options.world.threads = 0;
+  EXPECT_TRUE(ValidateNodeOptions(options).ok());
   options.world.threads = 2;
   EXPECT_TRUE(ValidateNodeOptions(options).ok());
 }

@@ -16,10 +16,12 @@
 
 namespace rigid_body_sim::node {
 
-// The node's defaults of the world settings: the core's, on every core.
+// The node's defaults of the world settings: the core's. One thread: on the
+// two-core machines measured (docs/performance.md) the fork-join pool cost
+// more than it saved, and the node's own threads want the second core.
 inline physics::WorldSettings NodeWorldSettings() {
   physics::WorldSettings world;
-  world.threads = 0;
+  world.threads = 1;
   return world;
 }
 
@@ -36,8 +38,8 @@ struct NodeOptions {
   // max_pivoting_points (count, 32)} and
   // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
   // (rad/s, 0.1), time_to_sleep (s, 0.5), speeding_up_time (s, 0.2)}; see
-  // physics/world_settings.h. ~threads (count, [0, 256], default 0: one
-  // per core) is the threads a step runs on; any count gives the same
+  // physics/world_settings.h. ~threads (count, [0, 256], default 1; 0:
+  // one per core) is the threads a step runs on; any count gives the same
   // motion bit for bit.
   physics::WorldSettings world = NodeWorldSettings();
   double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
