@@ -103,13 +103,15 @@ test-tsan: deps
 # the instrumented node. Any sanitizer report (a leak at exit included) fails
 # the target; the reports are in build/.ws-asan/asan.*. Allocations the
 # node's limits refuse come back as null instead of an ASan abort
-# (allocator_may_return_null), as they would without ASan.
+# (allocator_may_return_null), as they would without ASan. node_scale_test
+# is left out: it asserts the publish rate with 1,000 boxes, a speed the
+# sanitizers' several-fold slowdown does not keep.
 WS_ASAN := $(ROOT)/build/.ws-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 SANITIZE_TARGETS := rigid_body_sim_node rigid_body_sim_mesh_helper rigid_body_sim_generate_messages \
   rigid_body_sim_gencfg node_conversion_test \
   node_services_test node_falling_box_test node_contacts_test node_concurrency_test \
-  node_scale_test node_hostile_test node_time_stamps_test
+  node_hostile_test node_time_stamps_test
 sanitize: test-sanitize
 	$(MAKE) --no-print-directory ws-links WS=$(WS_ASAN)
 	catkin_make -C $(WS_ASAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -122,7 +124,7 @@ sanitize: test-sanitize
 	  ASAN_OPTIONS="detect_leaks=1 allocator_may_return_null=1 log_path=$(WS_ASAN)/asan" \
 	  LSAN_OPTIONS="suppressions=$(ROOT)/test/node/lsan.supp" \
 	  UBSAN_OPTIONS="print_stacktrace=1 log_path=$(WS_ASAN)/asan" \
-	  ctest --output-on-failure -R 'rostest|node_conversion'
+	  ctest --output-on-failure -R 'rostest|node_conversion' -E node_scale
 	@if ls $(WS_ASAN)/asan.* > /dev/null 2>&1; then \
 	  cat $(WS_ASAN)/asan.*; echo "[sanitize] a sanitizer reported an error" >&2; exit 1; fi
 	@echo "[sanitize] no AddressSanitizer or UndefinedBehaviorSanitizer reports"
