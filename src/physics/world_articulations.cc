@@ -231,7 +231,7 @@ std::vector<JointState> WorldImpl::GetJointStates(ArticulationId id) const {
 }
 
 // Positions and velocities of every joint, in joint order; a mimic joint's
-// entries are checked against its leader's and otherwise ignored.
+// entries are ignored. A position that changes must lie within its limits.
 Status WorldImpl::SetJointStates(ArticulationId id, const std::vector<double>& positions,
                                  const std::vector<double>& velocities) {
   if (!IsValid(id)) return Status::Error("no articulation with this id");
@@ -251,7 +251,10 @@ Status WorldImpl::SetJointStates(ArticulationId id, const std::vector<double>& p
                                           FormatNumber(velocities[j]) + " must be finite"));
     }
     if (joint.dof < 0) continue;
-    if (positions[j] < joint.def.lower || positions[j] > joint.def.upper) {
+    // Contacts may have pushed a joint past its limit, where the limit row
+    // is bringing it back: keeping that position is not setting one.
+    const bool kept = positions[j] == state.q[joint.dof];
+    if (!kept && (positions[j] < joint.def.lower || positions[j] > joint.def.upper)) {
       return Status::Error(JointField(
           j, joint.def.name,
           "position " + FormatNumber(positions[j]) + " is outside its limits [" +
