@@ -83,13 +83,17 @@ Status CheckOrigin(const TiXmlElement& parent, const std::string& where) {
   return rpy.status();
 }
 
-// A joint's <axis xyz> finite and not the zero vector (urdfdom keeps a zero
-// axis, about which the joint could not move); its <limit> effort and
+// A movable joint's <axis xyz> finite and not the zero vector (urdfdom keeps
+// a zero axis, about which the joint could not move; a fixed joint's is
+// never used); its <limit> effort and
 // velocity >= 0 (0, as many descriptions write it, is no limit) and its
 // lower and upper finite; its <dynamics> damping and friction >= 0.
 Status CheckJointElements(const TiXmlElement& joint, const std::string& where) {
   constexpr double kLargest = 1e300;
-  if (const TiXmlElement* axis = joint.FirstChildElement("axis"); axis != nullptr) {
+  const char* type = joint.Attribute("type");
+  const std::string kind = type == nullptr ? "" : type;
+  const bool movable = kind == "revolute" || kind == "continuous" || kind == "prismatic";
+  if (const TiXmlElement* axis = joint.FirstChildElement("axis"); axis != nullptr && movable) {
     const std::string at = where + " <axis>";
     Result<std::vector<double>> xyz = NumbersIn(*axis, "xyz", at, 3, -kLargest, kLargest, false);
     if (!xyz.ok()) return xyz.status();

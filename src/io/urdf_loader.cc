@@ -189,6 +189,7 @@ class ModelBuilder {
         return Status::Error("joint " + Quoted(name) + " position is not finite");
       }
       if (joint.type != urdf::Joint::CONTINUOUS && joint.limits != nullptr &&
+          joint.limits->lower <= joint.limits->upper &&
           (position < joint.limits->lower || position > joint.limits->upper)) {
         const char* unit = joint.type == urdf::Joint::PRISMATIC ? " m" : " rad";
         return Status::Error("joint " + Quoted(name) + " position " + FormatNumber(position) +
@@ -240,9 +241,15 @@ class ModelBuilder {
     axis.normalize();
     info->axis = axis;
     if (joint.limits != nullptr) {
-      if (joint.type != urdf::Joint::CONTINUOUS) {
+      // Bullet reads lower > upper as no limit, and descriptions written
+      // for it say so (lower 1, upper 0).
+      if (joint.type != urdf::Joint::CONTINUOUS && joint.limits->lower <= joint.limits->upper) {
         info->lower = joint.limits->lower;
         info->upper = joint.limits->upper;
+      } else if (joint.type != urdf::Joint::CONTINUOUS) {
+        loaded->warnings.push_back("joint " + Quoted(joint.name) + " <limit> lower " +
+                                   FormatNumber(joint.limits->lower) + " > upper " +
+                                   FormatNumber(joint.limits->upper) + ": no position limit");
       }
       // URDF's 0 means "not given" for effort and velocity in many
       // descriptions; it is taken as no limit rather than a locked joint.

@@ -4,6 +4,7 @@
 // a movable joint to 'world', and Gazebo's older <mu1 value="..."/>.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,27 @@ TEST(UrdfHabitsTest, JointStartsAtZeroBroughtWithinItsLimits) {
   model = LoadUrdfString(urdf, options);
   ASSERT_TRUE(model.ok()) << model.message();
   EXPECT_EQ(model->joints[0].position, -1.0);
+}
+
+// Bullet reads a <limit> with lower > upper as no position limit; a fixed
+// joint's zero <axis>, never used, is no error.
+TEST(UrdfHabitsTest, ReversedLimitsAreNoLimitAndFixedJointsNeedNoAxis) {
+  UrdfLoadOptions options;
+  options.articulate = true;
+  options.joint_positions = {{"base_forearm", 7.0}};
+  const Result<LoadedModel> model = LoadUrdfString(
+      "<robot name='arm'>" + Link("base", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1")) +
+          Link("forearm", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1")) +
+          Link("tool", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1")) +
+          Hinge("base", "forearm", "<limit lower='1' upper='0' effort='10' velocity='1'/>") +
+          "<joint name='weld' type='fixed'><parent link='forearm'/><child link='tool'/>"
+          "<axis xyz='0 0 0'/></joint></robot>",
+      options);
+  ASSERT_TRUE(model.ok()) << model.message();
+  ASSERT_EQ(model->joints.size(), 2u);
+  EXPECT_EQ(model->joints[0].position, 7.0);
+  EXPECT_EQ(model->joints[0].lower, -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(model->joints[0].upper, std::numeric_limits<double>::infinity());
 }
 
 // Bullet's arms state mass 0 for their base: the base is fixed where the
