@@ -63,9 +63,9 @@ def table(top, thickness, leg):
     return vertices, tris
 
 
-def write_binary_stl(path, vertices, tris):
+def write_binary_stl(path, vertices, tris, writer="make_concave_meshes.py"):
     with open(path, "wb") as f:
-        f.write(b"binary STL written by make_concave_meshes.py".ljust(80, b" "))
+        f.write(("binary STL written by " + writer).encode().ljust(80, b" "))
         f.write(struct.pack("<I", len(tris)))
         for tri in tris:
             a, b, c = (vertices[i] for i in tri)

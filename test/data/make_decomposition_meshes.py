@@ -13,15 +13,13 @@ Run from any directory: python3 test/data/make_decomposition_meshes.py
 """
 import math
 import os
-import struct
+import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from make_concave_meshes import quad, write_binary_stl  # noqa: E402
 
 
-def quad(tris, a, b, c, d):
-    """Two triangles of the quad a b c d, counter-clockwise from outside."""
-    tris.append((a, b, c))
-    tris.append((a, c, d))
 
 
 def mug(outer, inner, height, floor, segments):
@@ -64,22 +62,7 @@ def l_bracket(length, height, thickness, depth):
     return vertices, tris
 
 
-def write_binary_stl(path, vertices, tris):
-    with open(path, "wb") as f:
-        f.write(b"binary STL written by make_decomposition_meshes.py".ljust(80, b" "))
-        f.write(struct.pack("<I", len(tris)))
-        for tri in tris:
-            a, b, c = (vertices[i] for i in tri)
-            u = [b[k] - a[k] for k in range(3)]
-            v = [c[k] - a[k] for k in range(3)]
-            n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-            length = sum(x * x for x in n) ** 0.5
-            f.write(struct.pack("<3f", *(x / length for x in n)))
-            for i in tri:
-                f.write(struct.pack("<3f", *vertices[i]))
-            f.write(struct.pack("<H", 0))
-
-
 if __name__ == "__main__":
-    write_binary_stl(os.path.join(HERE, "mug.stl"), *mug(0.04, 0.035, 0.10, 0.01, 32))
-    write_binary_stl(os.path.join(HERE, "l_bracket.stl"), *l_bracket(0.3, 0.3, 0.05, 0.1))
+    writer = "make_decomposition_meshes.py"
+    write_binary_stl(os.path.join(HERE, "mug.stl"), *mug(0.04, 0.035, 0.10, 0.01, 32), writer)
+    write_binary_stl(os.path.join(HERE, "l_bracket.stl"), *l_bracket(0.3, 0.3, 0.05, 0.1), writer)
