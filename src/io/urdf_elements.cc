@@ -68,6 +68,28 @@ Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& rob
   return friction;
 }
 
+std::vector<std::string> FillOmittedProductsOfInertia(TiXmlElement* robot) {
+  std::vector<std::string> changed;
+  for (TiXmlElement* link = robot->FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    TiXmlElement* inertial = link->FirstChildElement("inertial");
+    TiXmlElement* inertia = inertial == nullptr ? nullptr : inertial->FirstChildElement("inertia");
+    if (inertia == nullptr || inertia->Attribute("ixx") == nullptr ||
+        inertia->Attribute("iyy") == nullptr || inertia->Attribute("izz") == nullptr) {
+      continue;
+    }
+    bool filled = false;
+    for (const char* product : {"ixy", "ixz", "iyz"}) {
+      if (inertia->Attribute(product) != nullptr) continue;
+      inertia->SetAttribute(product, "0");
+      filled = true;
+    }
+    const char* name = link->Attribute("name");
+    if (filled) changed.push_back(name == nullptr ? "" : name);
+  }
+  return changed;
+}
+
 namespace {
 
 // Raises the two smaller principal moments of `inertia` by one factor until

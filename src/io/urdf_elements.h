@@ -7,6 +7,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include <console_bridge/console.h>
 #include <tinyxml.h>
@@ -57,6 +58,11 @@ const char* JointTypeName(int type);
 // Friction coefficients from <gazebo reference="LINK"><mu1>, which urdfdom
 // does not read, so the XML is walked directly.
 physics::Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& robot);
+
+// Writes ixy, ixz and iyz = 0 into every <inertia> that gives ixx, iyy and
+// izz but leaves some of them out, as Bullet reads such a tensor (urdfdom
+// would hand back a zero tensor); returns the names of the links changed.
+std::vector<std::string> FillOmittedProductsOfInertia(TiXmlElement* robot);
 
 // A link's <inertial> as read, in the link frame, and what reading it changed.
 struct InertialReading {

@@ -59,7 +59,7 @@ class ModelBuilder {
           "malformed URDF XML at line " + std::to_string(document.ErrorRow()) + ", column " +
           std::to_string(document.ErrorCol()) + ": " + document.ErrorDesc());
     }
-    const TiXmlElement* robot = document.RootElement();
+    TiXmlElement* robot = document.RootElement();
     if (robot == nullptr || robot->ValueStr() != "robot") {
       return Result<LoadedModel>::Error("URDF root element must be <robot>");
     }
@@ -72,11 +72,25 @@ class ModelBuilder {
     if (!modes.ok()) return modes.status();
     mesh_modes_ = std::move(modes).value();
 
+    // urdfdom's reading of the document, with the products of inertia a
+    // description left out written in as 0.
+    std::string for_urdfdom = xml;
+    document_warnings_.clear();
+    for (const std::string& link : FillOmittedProductsOfInertia(robot)) {
+      document_warnings_.push_back("link " + Quoted(link) +
+                                   " <inertia> leaves out products of inertia; read as 0");
+    }
+    if (!document_warnings_.empty()) {
+      TiXmlPrinter printer;
+      document.Accept(&printer);
+      for_urdfdom = std::string(printer.CStr()) + std::string(16, '\0');
+    }
+
     urdf::ModelInterfaceSharedPtr model;
     std::string parser_messages;
     {
       ConsoleCapture capture;
-      model = urdf::parseURDF(xml);
+      model = urdf::parseURDF(for_urdfdom);
       parser_messages = capture.text();
     }
     if (model == nullptr) {
@@ -98,6 +112,7 @@ class ModelBuilder {
 
     LoadedModel loaded;
     loaded.name = model.getName();
+    loaded.warnings = document_warnings_;
     urdf::LinkConstSharedPtr body_root = model.getRoot();
     if (body_root->name == kWorldLink) {
       if (body_root->child_links.size() != 1) {
@@ -447,8 +462,9 @@ class ModelBuilder {
   UriResolver resolver_;
   std::map<std::string, double> friction_;
   MeshCollisionModes mesh_modes_;
-  bool static_model_ = false;  // fixed to `world`, massless, or spawned static
-  bool massless_ = false;      // every link states mass 0
+  bool static_model_ = false;                   // fixed to `world`, massless, or spawned static
+  bool massless_ = false;                       // every link states mass 0
+  std::vector<std::string> document_warnings_;  // what reading the XML itself changed
   UrdfMeshes meshes_;
 };
 

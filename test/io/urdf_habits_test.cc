@@ -133,6 +133,25 @@ TEST(UrdfHabitsTest, ReversedLimitsAreNoLimitAndFixedJointsNeedNoAxis) {
   EXPECT_EQ(model->joints[0].upper, std::numeric_limits<double>::infinity());
 }
 
+// An <inertia> giving only ixx, iyy and izz (Bullet's dinnerware) has zero
+// products of inertia, and keeps its link's collisions.
+TEST(UrdfHabitsTest, LeftOutProductsOfInertiaAreZero) {
+  const Result<LoadedModel> model = LoadUrdfString(
+      "<robot name='pan'>" +
+      Link("body",
+           "<inertial><mass value='2'/><inertia ixx='0.005' iyy='0.006' izz='0.0072'/>"
+           "</inertial>" +
+               Box("0.2 0.2 0.02")) +
+      "</robot>");
+  ASSERT_TRUE(model.ok()) << model.message();
+  ASSERT_EQ(model->shapes.size(), 1u);
+  const physics::Mat3& inertia = model->mass_properties.inertia_about_com;
+  EXPECT_DOUBLE_EQ(inertia(0, 0), 0.005);
+  EXPECT_DOUBLE_EQ(inertia(1, 1), 0.006);
+  EXPECT_DOUBLE_EQ(inertia(2, 2), 0.0072);
+  EXPECT_DOUBLE_EQ(inertia(0, 1), 0.0);
+}
+
 // Bullet's arms state mass 0 for their base: the base is fixed where the
 // model is spawned, and the arm's links keep their mass.
 TEST(UrdfHabitsTest, ArticulationWithAMasslessBaseIsFixed) {
