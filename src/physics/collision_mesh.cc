@@ -11,6 +11,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "physics/mesh_orientation.h"
+
 namespace rigid_body_sim::physics {
 namespace {
 
@@ -56,8 +58,8 @@ std::string Describe(const char* what, std::size_t index, const std::string& pro
 
 // Builds the mesh: vertices at bit-equal positions are welded (mesh files
 // repeat a vertex per triangle), triangles of zero area are dropped, each
-// triangle's normal is (v1 - v0) x (v2 - v0) normalised, then the edge
-// adjacency (FindNeighbours) and the tree (BuildTree).
+// triangle's normal is (v1 - v0) x (v2 - v0) normalised, then the winding
+// (Orient), the edge adjacency (FindNeighbours) and the tree (BuildTree).
 Result<std::shared_ptr<const CollisionMesh>> CollisionMesh::Make(const TriangleMesh& mesh) {
   using Out = Result<std::shared_ptr<const CollisionMesh>>;
   if (mesh.triangles.size() > kMaxTriangles) {
@@ -103,17 +105,35 @@ Result<std::shared_ptr<const CollisionMesh>> CollisionMesh::Make(const TriangleM
     return Out::Error("triangle mesh has no triangle of non-zero area (of " +
                       std::to_string(mesh.triangles.size()) + ")");
   }
+  built->Orient();
   built->FindNeighbours();
   built->BuildTree();
   return Out(std::shared_ptr<const CollisionMesh>(std::move(built)));
 }
 
+// Reverses the triangles that OrientComponents finds wound against their
+// component (two vertices swapped, the normal negated) and makes those of
+// open components two-sided.
+void CollisionMesh::Orient() {
+  std::vector<std::array<int, 3>> corners(triangles_.size());
+  for (std::size_t t = 0; t < triangles_.size(); ++t) corners[t] = triangles_[t].vertices;
+  const MeshOrientation orientation = OrientComponents(vertices_, corners);
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    Triangle& triangle = triangles_[t];
+    if (orientation.flip[t] != 0) {
+      std::swap(triangle.vertices[1], triangle.vertices[2]);
+      triangle.normal = -triangle.normal;
+    }
+    triangle.two_sided = orientation.open[t] != 0;
+  }
+}
+
 // Edge adjacency by sorting the edges on their vertex pair. An edge of
 // exactly two triangles gets the other's normal, negated when the two run
-// the edge the same way (inconsistent winding), and its fold: with w the
-// neighbour's third vertex and v a vertex of the edge, n . (w - v) < 0 means
-// the surface turns away from the normal side (convex), > 0 towards it
-// (concave), and about 0 means coplanar.
+// the edge the same way (after Orient, only in a non-orientable component),
+// and its fold: with w the neighbour's third vertex and v a vertex of the
+// edge, n . (w - v) < 0 means the surface turns away from the normal side
+// (convex), > 0 towards it (concave), and about 0 means coplanar.
 void CollisionMesh::FindNeighbours() {
   std::vector<std::pair<std::uint64_t, int>> edges;  // (vertex pair, 3 t + k)
   edges.reserve(3 * triangles_.size());

@@ -1,9 +1,11 @@
 // Static triangle meshes for concave environments (bins, shelves, tables,
 // terrain): the triangles with their edge adjacency, in a bounding-volume
-// hierarchy built once. Triangles collide on their front side, the side
-// their counter-clockwise winding's normal points to: a closed mesh (as
-// mesh files of solids are) from outside, a terrain sheet from above. A
-// wall of one layer stops bodies coming at its front only.
+// hierarchy built once. The winding given need not be consistent: each
+// connected component is wound consistently when the mesh is built, a
+// closed one with its normals outward. A closed component's triangles
+// collide on their front (outer) side only, so that a body is never pushed
+// into the solid; an open component's (a sheet, a terrain, a wall of one
+// layer) collide on whichever side a body's centre is.
 #ifndef RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
 #define RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
 
@@ -29,6 +31,8 @@ class CollisionMesh {
   struct Triangle {
     std::array<int, 3> vertices{};  // counter-clockwise seen from the side `normal` points to
     Vec3 normal = Vec3::UnitZ();    // unit
+    // Of an open component: collides from both sides.
+    bool two_sided = false;
     // Edge k runs from vertices[k] to vertices[(k + 1) % 3]. The normal of
     // the triangle across it, oriented as this one (this triangle's own
     // normal for a boundary or non-manifold edge), and the edge's fold seen
@@ -47,8 +51,9 @@ class CollisionMesh {
     int count = 0;
   };
 
-  // Welds vertices at equal positions, drops triangles of zero area, finds
-  // each edge's neighbour and builds the tree. Fails with a message for a
+  // Welds vertices at equal positions, drops triangles of zero area, winds
+  // each connected component consistently, finds each edge's neighbour and
+  // builds the tree. Fails with a message for a
   // vertex that is not finite, an index out of range, no triangle of
   // non-zero area, or more than kMaxTriangles triangles.
   static Result<std::shared_ptr<const CollisionMesh>> Make(const TriangleMesh& mesh);
@@ -71,6 +76,7 @@ class CollisionMesh {
 
  private:
   CollisionMesh() = default;
+  void Orient();
   void FindNeighbours();
   void BuildTree();
 
