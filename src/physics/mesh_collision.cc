@@ -86,10 +86,14 @@ ConvexPolyhedron MakePrismTopology() {
 // normal against the adjacent face normals (Mirtich 1998, "V-Clip: Fast and
 // Robust Polyhedral Collision Detection", ACM TOG 17(3), section 3.1, for
 // the regions; Bullet's btInternalEdgeUtility for the use on meshes).
-bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, const Vec3& on_triangle,
-                    const Vec3& normal) {
+// A two-sided triangle met from behind (`back`) is the surface seen from
+// its other side: the face and neighbour normals negate, and a fold convex
+// from the front is concave from behind and the other way round.
+bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, bool back,
+                    const Vec3& on_triangle, const Vec3& normal) {
   const CollisionMesh::Triangle& triangle = mesh.triangles()[triangle_index];
-  const Vec3& front = triangle.normal;
+  const double side = back ? -1.0 : 1.0;
+  const Vec3 front = side * triangle.normal;
   if (normal.dot(front) >= kFaceNormalCosine) return true;
   int nearest = 0;
   double nearest_distance = std::numeric_limits<double>::infinity();
@@ -105,18 +109,23 @@ bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, const Vec3& o
       nearest_t = t;
     }
   }
-  const auto edge_open = [&](int k) {
+  const auto fold_seen = [&](int k) {
     const Fold fold = triangle.edge_folds.at(k);
+    if (!back || fold == Fold::kFlat || fold == Fold::kBoundary) return fold;
+    return fold == Fold::kConvex ? Fold::kConcave : Fold::kConvex;
+  };
+  const auto edge_open = [&](int k) {
+    const Fold fold = fold_seen(k);
     return fold == Fold::kBoundary || fold == Fold::kConvex;
   };
   if (nearest_t <= kVertexFraction || nearest_t >= 1.0 - kVertexFraction) {
     const int other = nearest_t <= kVertexFraction ? (nearest + 2) % 3 : (nearest + 1) % 3;
     return edge_open(nearest) || edge_open(other);
   }
-  const Fold fold = triangle.edge_folds.at(nearest);
+  const Fold fold = fold_seen(nearest);
   if (fold == Fold::kBoundary) return true;
   if (fold != Fold::kConvex) return false;
-  const Vec3& neighbour = triangle.neighbour_normals[nearest];
+  const Vec3 neighbour = side * triangle.neighbour_normals[nearest];
   const double bound = front.dot(neighbour) - kRegionSlack;
   return normal.dot(front) >= bound && normal.dot(neighbour) >= bound;
 }
@@ -220,13 +229,17 @@ void MakeTrianglePrism(const std::array<Vec3, 3>& front_ccw, double depth,
 // The triangles whose boxes come within the contact distance of the convex
 // shape's box (CollisionMesh::QueryBox) are each taken as the prism behind
 // their face, extruded away from the shape by more than the shape's
-// diameter, so that the prism's back never decides a contact. Triangles
-// collide on their front (normal) side only: one whose plane has the
-// shape's centre behind it is skipped (the underside of a bin's floor must
-// not hold up a box resting on the floor's top, 5 mm above, and the plane
-// of a far triangle of a hillside may pass above a box in the valley), as
-// is one whose plane the shape lies in front of by the contact distance
-// (its support point along -n, which also bounds the gap).
+// diameter, so that the prism's back never decides a contact. A triangle of
+// a closed component collides on its front (outer) side only: one whose
+// plane has the shape's centre behind it is skipped (the underside of a
+// bin's floor must not hold up a box resting on the floor's top, 5 mm
+// above). A two-sided triangle (of an open component: a sheet, a terrain)
+// collides on the side of its plane the shape's centre is on: from behind
+// it is taken reversed, its winding, prism and edge regions those of the
+// other side, as Bullet's and Gazebo's triangle meshes collide from both
+// sides. A triangle whose plane the shape lies in front of by the contact
+// distance (its support point along -n, which also bounds the gap) is
+// skipped too.
 // Each prism is collided with the convex routines of the narrow phase
 // (separating axes and clipping for polyhedra, exact for spheres and
 // cylinders), and the normal is checked against the Voronoi region of the
@@ -248,10 +261,12 @@ namespace {
 // The triangles near a convex shape and how each one is collided with it.
 class TriangleQuery {
  public:
-  // A candidate triangle and a lower bound on its separation from the shape.
+  // A candidate triangle, a lower bound on its separation from the shape,
+  // and whether the shape meets it from behind (a two-sided triangle).
   struct Candidate {
     int triangle = 0;
     double bound = 0.0;  // m
+    bool back = false;
   };
 
   // The triangles whose boxes come within the contact distance of the
@@ -278,28 +293,35 @@ class TriangleQuery {
     const Mat3 convex_from_mesh = mesh_from_convex_.rotation.conjugate().toRotationMatrix();
     for (const int t : found) {
       const CollisionMesh::Triangle& triangle = mesh_.triangles()[t];
-      const double plane = triangle.normal.dot(mesh_.vertices()[triangle.vertices[0]]);
-      // Seen from behind, or in front of the plane by the contact distance
-      // (the plane's distance bounds the triangle's): no contact.
-      if (triangle.normal.dot(center_mesh) < plane) continue;
-      const double bound = triangle.normal.dot(mesh_from_convex_.translation) +
-                           LowestAlong(*pair.convex, convex_from_mesh * triangle.normal) - plane;
+      const double offset = triangle.normal.dot(mesh_.vertices()[triangle.vertices[0]]);
+      // A one-sided triangle seen from behind: no contact.
+      const bool back = triangle.normal.dot(center_mesh) < offset;
+      if (back && !triangle.two_sided) continue;
+      const double side = back ? -1.0 : 1.0;
+      const Vec3 normal = side * triangle.normal;
+      const double plane = side * offset;
+      // In front of the plane by the contact distance (the plane's distance
+      // bounds the triangle's): no contact.
+      const double bound = normal.dot(mesh_from_convex_.translation) +
+                           LowestAlong(*pair.convex, convex_from_mesh * normal) - plane;
       if (bound >= pair.contact_distance) {
         *gap = std::min(*gap, bound);
         continue;
       }
-      candidates->push_back({t, bound});
+      candidates->push_back({t, bound, back});
     }
   }
 
-  // The manifold of triangle t's prism, true when it has points whose
-  // normal lies in the touched feature's region; else `gap` is lowered to
-  // the separation found, when known.
-  bool Collide(int t, ContactManifold* manifold, double* gap) {
-    const CollisionMesh::Triangle& triangle = mesh_.triangles()[t];
+  // The manifold of the candidate's prism, on the side the shape meets it,
+  // true when it has points whose normal lies in the touched feature's
+  // region; else `gap` is lowered to the separation found, when known.
+  bool Collide(const Candidate& candidate, ContactManifold* manifold, double* gap) {
+    const CollisionMesh::Triangle& triangle = mesh_.triangles()[candidate.triangle];
+    // Reversed, counter-clockwise seen from behind.
+    const int second = candidate.back ? 2 : 1;
     MakeTrianglePrism(
-        {mesh_.vertices()[triangle.vertices[0]], mesh_.vertices()[triangle.vertices[1]],
-         mesh_.vertices()[triangle.vertices[2]]},
+        {mesh_.vertices()[triangle.vertices[0]], mesh_.vertices()[triangle.vertices[second]],
+         mesh_.vertices()[triangle.vertices[3 - second]]},
         depth_, &prism_);
     CollideStats stats;
     if (!physics::Collide({pair_.convex, pair_.world_from_convex, &prism_geometry_,
@@ -317,7 +339,7 @@ class TriangleQuery {
         pair_.world_from_mesh.Inverse() *
         (point.position_world - 0.5 * point.separation * manifold->normal_world);
     const Vec3 normal_mesh = world_from_mesh_rotation_.transpose() * manifold->normal_world;
-    return NormalInRegion(mesh_, t, on_triangle, normal_mesh);
+    return NormalInRegion(mesh_, candidate.triangle, candidate.back, on_triangle, normal_mesh);
   }
 
  private:
@@ -343,7 +365,7 @@ void CollideConvexMesh(const ConvexMeshPair& pair, MeshContacts* contacts) {
   int group_count = 0;
   for (const TriangleQuery::Candidate& candidate : candidates) {
     ContactManifold manifold;
-    if (query.Collide(candidate.triangle, &manifold, &gap)) {
+    if (query.Collide(candidate, &manifold, &gap)) {
       AddToGroups(manifold, candidate.triangle, &groups, &group_count);
     }
   }
@@ -388,7 +410,7 @@ bool CollideConvexMeshDeepest(const ConvexMeshPair& pair, ContactManifold* manif
   for (const TriangleQuery::Candidate& candidate : candidates) {
     if (candidate.bound >= deepest) break;
     ContactManifold found;
-    if (!query.Collide(candidate.triangle, &found, gap)) continue;
+    if (!query.Collide(candidate, &found, gap)) continue;
     double least = std::numeric_limits<double>::infinity();
     for (int i = 0; i < found.point_count; ++i) least = std::min(least, found.points[i].separation);
     if (least < deepest) {
