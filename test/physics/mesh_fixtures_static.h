@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/mass_properties.h"
@@ -47,6 +48,14 @@ inline TriangleMesh MakeGrid(double x0, double y0, double cell, int nx, int ny,
     }
   }
   return mesh;
+}
+
+// Reverses the winding of the triangles t for which reverse(t) holds, as
+// mesh files with faces exported the wrong way have them.
+inline void ReverseTriangles(const std::function<bool(int)>& reverse, TriangleMesh* mesh) {
+  for (int t = 0; t < static_cast<int>(mesh->triangles.size()); ++t) {
+    if (reverse(t)) std::swap(mesh->triangles[t][1], mesh->triangles[t][2]);
+  }
 }
 
 // An open bin centred on the z axis: outer size `outer` (x, y, z), walls and

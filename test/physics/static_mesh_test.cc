@@ -4,11 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "mesh_fixtures_static.h"
+#include "physics/mesh_collision.h"
+#include "physics/mesh_orientation.h"
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/world.h"
 #include "scene.h"
@@ -155,15 +161,18 @@ TEST(StaticMeshWorldTest, BoxRestsOnBinFloor) {
   EXPECT_TRUE(reported || !body.awake);
 }
 
+// A floor of 5 cm cells (two triangles each), 2 m x 1 m, at z = 0.
+TriangleMesh SlidingFloor() {
+  return testing::MakeGrid(-1.0, -0.5, 0.05, 80, 20, [](double, double) { return 0.0; });
+}
+
 // A box sliding across a floor of 5 cm cells (two triangles each) keeps a
 // straight, level path: it decelerates at mu g and never bumps on the
 // triangles' internal edges.
-TEST(StaticMeshWorldTest, BoxSlidesSmoothlyOverTessellatedFloor) {
+void ExpectSmoothSlide(const TriangleMesh& floor) {
   WorldSettings settings;
   World world(settings);
-  AddStaticMesh(&world,
-                testing::MakeGrid(-1.0, -0.5, 0.05, 80, 20, [](double, double) { return 0.0; }),
-                MakeMaterial(0.2, 0.0));
+  AddStaticMesh(&world, floor, MakeMaterial(0.2, 0.0));
   BoxSpec spec;
   spec.size = Vec3::Constant(0.1);
   spec.world_from_body = Translation(-0.8, 0.013, 0.05);
@@ -185,6 +194,12 @@ TEST(StaticMeshWorldTest, BoxSlidesSmoothlyOverTessellatedFloor) {
   const double distance = 1.5 * 1.5 / (2.0 * 0.2 * 9.81);
   EXPECT_NEAR(body.position.x(), -0.8 + distance, 5e-3);
   EXPECT_NEAR(body.position.z(), 0.05, 1e-3);
+  std::printf("slide: lateral %.3g m, |v_z| %.3g m/s, stop x %.6f m (closed form %.6f), z %.6f m\n",
+              lateral, vertical_speed, body.position.x(), -0.8 + distance, body.position.z());
+}
+
+TEST(StaticMeshWorldTest, BoxSlidesSmoothlyOverTessellatedFloor) {
+  ExpectSmoothSlide(SlidingFloor());
 }
 
 // A 5 cm ball rolled at 1 m/s passes under a table top (30 cm high) between
@@ -228,9 +243,9 @@ TEST(StaticMeshWorldTest, LargeBallStopsAtTableTop) {
 }
 
 // A sphere fired at 200 m/s (0.83 m a step) stops at a wall instead of
-// passing through: a wall of two triangles with no thickness, hit on its
-// front, and a closed 2 mm slab, hit from either side. It bounces back at
-// e = 0.5.
+// passing through: a wall of two triangles with no thickness (an open
+// sheet, two-sided) and a closed 2 mm slab, each hit from either side. It
+// bounces back at e = 0.5.
 TEST(StaticMeshWorldTest, FastSphereDoesNotPassThinWall) {
   TriangleMesh sheet;
   sheet.vertices = {Vec3(1.0, -1.0, -1.0), Vec3(1.0, 1.0, -1.0), Vec3(1.0, 1.0, 1.0),
@@ -242,7 +257,8 @@ TEST(StaticMeshWorldTest, FastSphereDoesNotPassThinWall) {
     const TriangleMesh* wall;
     double side;  // +1: coming from -x, -1: from +x
   };
-  for (const Case& shot : {Case{&sheet, -1.0}, Case{&slab, 1.0}, Case{&slab, -1.0}}) {
+  for (const Case& shot :
+       {Case{&sheet, -1.0}, Case{&sheet, 1.0}, Case{&slab, 1.0}, Case{&slab, -1.0}}) {
     WorldSettings settings;
     settings.gravity = Vec3::Zero();
     World world(settings);
@@ -258,6 +274,8 @@ TEST(StaticMeshWorldTest, FastSphereDoesNotPassThinWall) {
     const double half = shot.wall == &slab ? 0.001 : 0.0;
     EXPECT_LT(shot.side * (body.position.x() - 1.0), -0.05 - half + 1e-3) << "side " << shot.side;
     EXPECT_NEAR(body.linear_velocity.x(), -shot.side * 100.0, 1.0) << "side " << shot.side;
+    std::printf("%s from %s: x %.6f m, v_x %.4f m/s\n", shot.wall == &slab ? "slab" : "sheet",
+                shot.side > 0.0 ? "-x" : "+x", body.position.x(), body.linear_velocity.x());
   }
 }
 
@@ -281,6 +299,170 @@ TEST(StaticMeshWorldTest, CylinderRestsOnMesh) {
     EXPECT_NEAR(body.position.z(), standing ? 0.15 : 0.05, 1e-3) << "standing " << standing;
     EXPECT_LT(body.linear_velocity.norm(), 1e-2);
   }
+}
+
+// The signed volume of a triangle mesh, sum of a . (b x c) / 6: positive
+// when a closed mesh's normals point out.
+double SignedVolume(const std::vector<Vec3>& vertices,
+                    const std::vector<std::array<int, 3>>& triangles) {
+  double volume = 0.0;
+  for (const std::array<int, 3>& t : triangles) {
+    volume += vertices[t[0]].dot(vertices[t[1]].cross(vertices[t[2]])) / 6.0;
+  }
+  return volume;
+}
+
+std::vector<std::array<int, 3>> Corners(const TriangleMesh& mesh) {
+  std::vector<std::array<int, 3>> corners;
+  for (const Eigen::Vector3i& t : mesh.triangles) corners.push_back({t[0], t[1], t[2]});
+  return corners;
+}
+
+// A cube (1 x 2 x 3 m) with five of its twelve triangles reversed, and one
+// turned wholly inside out: after orientation every edge is run once in
+// each direction and the volume is +6 m^3.
+TEST(MeshOrientationTest, ClosedMeshBecomesConsistentAndOutward) {
+  for (const bool inside_out : {false, true}) {
+    TriangleMesh cube;
+    testing::AppendBox(Vec3(-0.5, -1.0, 0.5), Vec3(0.5, 1.0, 3.5), &cube);
+    testing::ReverseTriangles(
+        [inside_out](int t) {
+          return inside_out || t == 0 || t == 3 || t == 4 || t == 7 || t == 11;
+        },
+        &cube);
+    std::vector<std::array<int, 3>> corners = Corners(cube);
+    const MeshOrientation orientation = OrientComponents(cube.vertices, corners);
+    EXPECT_EQ(orientation.components, 1);
+    std::map<std::pair<int, int>, int> runs;  // directed edge -> triangles running it
+    for (std::size_t t = 0; t < corners.size(); ++t) {
+      EXPECT_EQ(orientation.open[t], 0);
+      if (orientation.flip[t] != 0) std::swap(corners[t][1], corners[t][2]);
+      for (int k = 0; k < 3; ++k) ++runs[{corners[t][k], corners[t][(k + 1) % 3]}];
+    }
+    EXPECT_EQ(runs.size(), 36u);  // 18 edges, each both ways
+    for (const auto& [edge, count] : runs) {
+      EXPECT_EQ(count, 1) << edge.first << " -> " << edge.second;
+      EXPECT_EQ(runs.count({edge.second, edge.first}), 1u) << edge.first << " -> " << edge.second;
+    }
+    EXPECT_NEAR(SignedVolume(cube.vertices, corners), 6.0, 1e-12) << "inside out " << inside_out;
+    // Built, its triangles face away from the centre and are one-sided.
+    const auto mesh = Build(cube);
+    for (const CollisionMesh::Triangle& triangle : mesh->triangles()) {
+      EXPECT_FALSE(triangle.two_sided);
+      EXPECT_GT(triangle.normal.dot(mesh->vertices()[triangle.vertices[0]] - Vec3(0.0, 0.0, 2.0)),
+                0.0);
+    }
+  }
+}
+
+// An open grid with a third of its triangles reversed takes the winding of
+// the other two thirds (facing +z) and is two-sided; the bin's five boxes,
+// meeting at edges of four triangles, stay closed and one-sided.
+TEST(MeshOrientationTest, OpenSheetTakesMajorityAndBinStaysClosed) {
+  TriangleMesh grid = testing::MakeGrid(0.0, 0.0, 0.1, 6, 5, [](double, double) { return 0.0; });
+  testing::ReverseTriangles([](int t) { return t % 3 == 1; }, &grid);
+  const MeshOrientation orientation = OrientComponents(grid.vertices, Corners(grid));
+  EXPECT_EQ(orientation.components, 1);
+  const auto sheet = Build(grid);
+  for (const CollisionMesh::Triangle& triangle : sheet->triangles()) {
+    EXPECT_TRUE(triangle.two_sided);
+    EXPECT_EQ(triangle.normal, Vec3::UnitZ());
+  }
+  const auto bin = Build(testing::MakeBin(Vec3(0.4, 0.3, 0.2), 0.005));
+  for (const CollisionMesh::Triangle& triangle : bin->triangles()) {
+    EXPECT_FALSE(triangle.two_sided);
+  }
+}
+
+// A V-shaped sheet (10 degree slopes) is a valley from above and a ridge
+// from below: a box pressed up 2 mm into its bottom edge from below meets
+// the ridge with its top face, normal -z and depth 2 mm, which the ridge's
+// convex edge region admits (taken as the valley's concave edge, it would
+// be dropped and the box would pass into the sheet).
+TEST(MeshOrientationTest, ValleySeenFromBelowIsARidge) {
+  const double slope = std::tan(10.0 * M_PI / 180.0);
+  TriangleMesh valley;
+  for (const double x : {-1.0, 0.0, 1.0}) {
+    for (const double y : {-1.0, 1.0}) valley.vertices.emplace_back(x, y, slope * std::abs(x));
+  }
+  // Vertex 2 i + j is (x_i, y_j); counter-clockwise from above.
+  valley.triangles = {Eigen::Vector3i(0, 2, 3), Eigen::Vector3i(0, 3, 1), Eigen::Vector3i(2, 4, 5),
+                      Eigen::Vector3i(2, 5, 3)};
+  const auto mesh = Build(valley);
+  const ShapeGeometry box =
+      std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3::Constant(0.1)));
+  const ConvexMeshPair pair{&box, Translation(0.01, 0.02, -0.048), mesh.get(), Pose::Identity(),
+                            0.01};
+  ContactManifold manifold;
+  double gap = 0.0;
+  ASSERT_TRUE(CollideConvexMeshDeepest(pair, &manifold, &gap));
+  double deepest = 0.0;
+  for (int i = 0; i < manifold.point_count; ++i) {
+    deepest = std::min(deepest, manifold.points[i].separation);
+  }
+  EXPECT_NEAR(deepest, -0.002, 1e-9);
+  EXPECT_NEAR(manifold.normal_world.z(), -1.0, 1e-9);
+}
+
+// A 10 cm box dropped (tilted) from `height` onto `floor` comes to rest with
+// its centre at `rest_z` (m), within 1 mm; `gravity` along z.
+void ExpectBoxRestsAt(const TriangleMesh& floor, double height, double gravity, double rest_z) {
+  WorldSettings settings;
+  settings.gravity = Vec3(0.0, 0.0, gravity);
+  World world(settings);
+  AddStaticMesh(&world, floor, MakeMaterial(0.5, 0.0));
+  BoxSpec spec;
+  spec.size = Vec3::Constant(0.1);
+  spec.world_from_body = Translation(0.03, -0.02, height);
+  spec.world_from_body.rotation = Quat(Eigen::AngleAxisd(0.3, Vec3(1.0, 2.0, 0.5).normalized()));
+  spec.material = MakeMaterial(0.5, 0.0);
+  const BodyId box = AddBox(&world, spec);
+  for (int step = 0; step < 3 * 240; ++step) world.Step();
+  const Body& body = world.GetBody(box);
+  EXPECT_NEAR(body.position.z(), rest_z, 1e-3);
+  EXPECT_LT(body.linear_velocity.norm(), 1e-3);
+  std::printf("rest: z %.6f m (closed form %.6f), |v| %.3g m/s\n", body.position.z(), rest_z,
+              body.linear_velocity.norm());
+}
+
+// A floor whose triangles all face down (exported upside down) holds a box
+// at floor + half its height; front-side-only triangles let it fall through.
+TEST(StaticMeshWorldTest, BoxRestsOnDownFacingFloor) {
+  TriangleMesh floor =
+      testing::MakeGrid(-0.5, -0.5, 0.1, 10, 10, [](double, double) { return 0.2; });
+  testing::ReverseTriangles([](int) { return true; }, &floor);
+  ExpectBoxRestsAt(floor, 0.5, -9.81, 0.25);
+}
+
+// A box falling upwards (gravity reversed) onto the floor sheet from below
+// stops with its top at the sheet, its centre half its height below.
+TEST(StaticMeshWorldTest, BoxRisingStopsUnderSheet) {
+  const TriangleMesh sheet =
+      testing::MakeGrid(-0.5, -0.5, 0.1, 10, 10, [](double, double) { return 0.2; });
+  ExpectBoxRestsAt(sheet, -0.1, 9.81, 0.15);
+}
+
+// A floor with a checkerboard of reversed cells: a box rests on it at the
+// same height and slides across it as over a consistent floor.
+TEST(StaticMeshWorldTest, CheckerboardFloorActsAsConsistentFloor) {
+  TriangleMesh checkerboard =
+      testing::MakeGrid(-0.5, -0.5, 0.1, 10, 10, [](double, double) { return 0.2; });
+  testing::ReverseTriangles([](int t) { return (t / 2 % 10 + t / 20) % 2 == 0; }, &checkerboard);
+  ExpectBoxRestsAt(checkerboard, 0.5, -9.81, 0.25);
+  TriangleMesh floor = SlidingFloor();
+  testing::ReverseTriangles([](int t) { return (t / 2 % 80 + t / 160) % 2 == 0; }, &floor);
+  ExpectSmoothSlide(floor);
+}
+
+// A closed block (1 x 1 x 0.2 m) whose top face and one side were exported
+// reversed is wound outward when built: a box rests on its top, and the
+// block stays one-sided.
+TEST(StaticMeshWorldTest, BoxRestsOnClosedBlockWithReversedFaces) {
+  TriangleMesh block;
+  testing::AppendBox(Vec3(-0.5, -0.5, 0.0), Vec3(0.5, 0.5, 0.2), &block);
+  // Triangles 10 and 11 are the top (+z), 2 and 3 the +x side.
+  testing::ReverseTriangles([](int t) { return t == 2 || t == 3 || t == 10 || t == 11; }, &block);
+  ExpectBoxRestsAt(block, 0.5, -9.81, 0.25);
 }
 
 }  // namespace
