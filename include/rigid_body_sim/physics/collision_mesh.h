@@ -3,9 +3,10 @@
 // hierarchy built once. The winding given need not be consistent: each
 // connected component is wound consistently when the mesh is built, a
 // closed one with its normals outward. A closed component's triangles
-// collide on their front (outer) side only, so that a body is never pushed
-// into the solid; an open component's (a sheet, a terrain, a wall of one
-// layer) collide on whichever side a body's centre is.
+// collide on their front (outer) side only: the underside of a bin's 5 mm
+// floor must not hold up a box resting on the floor's top. An open
+// component's (a sheet, a terrain, a wall of one layer) collide on
+// whichever side a body's centre is.
 #ifndef RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
 #define RIGID_BODY_SIM_PHYSICS_COLLISION_MESH_H_
 
