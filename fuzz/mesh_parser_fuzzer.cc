@@ -1,11 +1,13 @@
 // libFuzzer harness for the mesh helper and its protocol. The bytes are, in
-// turn: a helper reply, which the node parses (ParseHullReply); a point set,
-// hulled by qhull as the helper does, whose reply must parse back to the
-// same hull; and a mesh file (first byte: STL, OBJ, PLY or DAE) handed to
-// the real helper process, whose answer, death or timeout must come back as
-// a result. Assimp itself runs only in the helper: in process it loops
-// forever on some headers (test/data/hang_header.ply, found here), which is
-// what the helper's CPU limit is for.
+// turn: a helper reply, which the node parses as a hull (ParseHullReply) and
+// as a convex decomposition's pieces (ParsePiecesReply); a point set, hulled
+// by qhull as the helper does, whose hull reply, and pieces reply with the
+// hull as two pieces, must parse back to the same hulls; and a mesh file
+// (first byte: STL, OBJ, PLY or DAE) handed to the real helper process,
+// whose answer, death or timeout must come back as a result. Assimp itself
+// runs only in the helper: in process it loops forever on some headers
+// (test/data/hang_header.ply, found here), which is what the helper's CPU
+// limit is for.
 #include <unistd.h>
 
 #include <cstddef>
@@ -36,13 +38,21 @@ void CheckHullRoundTrip(const std::uint8_t* data, std::size_t size) {
   const auto back =
       rigid_body_sim::io::ParseHullReply(rigid_body_sim::io::FormatHullReply(*hull), 1 << 20);
   if (!back.ok() || back->vertices != hull->vertices) std::abort();
+  const rigid_body_sim::io::ConvexPieceList pieces{*hull, *hull};
+  const auto parsed =
+      rigid_body_sim::io::ParsePiecesReply(rigid_body_sim::io::FormatPiecesReply(pieces), 1 << 20);
+  if (!parsed.ok() || parsed->size() != 2) std::abort();
+  for (const auto& piece : *parsed) {
+    if (piece.vertices != hull->vertices) std::abort();
+  }
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  (void)rigid_body_sim::io::ParseHullReply(std::string(reinterpret_cast<const char*>(data), size),
-                                           256);
+  const std::string reply(reinterpret_cast<const char*>(data), size);
+  (void)rigid_body_sim::io::ParseHullReply(reply, 256);
+  (void)rigid_body_sim::io::ParsePiecesReply(reply, 256);
   CheckHullRoundTrip(data, size);
   if (size == 0) return 0;
   static const char* const kExtensions[] = {".stl", ".obj", ".ply", ".dae"};
