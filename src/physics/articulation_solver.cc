@@ -93,6 +93,9 @@ void ArticulationSolver::ApplyImpulse(const ConstraintRow& row, double impulse) 
       articulations_[side->slot].u += impulse * side->response;
     } else if (side->kind == RowSide::Kind::kBody) {
       BodySlot& body = bodies_[side->slot];
+      // As in ContactSolver::ApplyImpulse: a body that does not move keeps
+      // its zero velocity even when the impulse overflowed.
+      if (body.inverse_mass == 0.0) continue;
       body.linear_velocity += impulse * side->linear_response;
       body.angular_velocity += impulse * side->angular_response;
     }

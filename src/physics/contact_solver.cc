@@ -77,10 +77,18 @@ void ContactSolver::ApplyImpulse(const SolverManifold& manifold, const SolverPoi
                                  const Vec3& impulse_world) {
   SolverBody& a = bodies_[manifold.body_a];
   SolverBody& b = bodies_[manifold.body_b];
-  a.linear_velocity += a.inverse_mass * impulse_world;
-  a.angular_velocity += Multiply(a.inverse_inertia_world, point.r_a.cross(impulse_world));
-  b.linear_velocity -= b.inverse_mass * impulse_world;
-  b.angular_velocity -= Multiply(b.inverse_inertia_world, point.r_b.cross(impulse_world));
+  // A body that does not move (static, asleep) is skipped, not multiplied
+  // by its zero inverse mass: an impulse that overflowed would make its
+  // velocity 0 * inf = NaN, and every body touching it (the ground: all of
+  // them) would read that NaN. The step guard freezes the pair's moving body.
+  if (a.inverse_mass != 0.0) {
+    a.linear_velocity += a.inverse_mass * impulse_world;
+    a.angular_velocity += Multiply(a.inverse_inertia_world, point.r_a.cross(impulse_world));
+  }
+  if (b.inverse_mass != 0.0) {
+    b.linear_velocity -= b.inverse_mass * impulse_world;
+    b.angular_velocity -= Multiply(b.inverse_inertia_world, point.r_b.cross(impulse_world));
+  }
 }
 
 void ContactSolver::RecordStartVelocities() {

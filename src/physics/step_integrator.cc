@@ -147,10 +147,32 @@ void WorldImpl::IntegrateBodies(double dt) {
   UpdateSleep(dt);
 }
 
+// Scales a moving body's angular momenta (at the start and the end of the
+// step) so that its angular velocity turns it at most max_turn_per_step in
+// dt: |w| <= max_turn / dt with w = I^-1 L. The scale keeps the spin's axis;
+// it only takes energy out, and only from spins no step resolves.
+void WorldImpl::CapSpin(double dt) {
+  const double max_speed = settings_.max_turn_per_step / dt;
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.awake || body.disabled) continue;
+    const double end_speed = body.angular_velocity.norm();
+    const double start_speed = (body.inverse_inertia_world * body.start_angular_momentum).norm();
+    // Written so that NaN passes on to the step guard unchanged.
+    if (!(end_speed > max_speed) && !(start_speed > max_speed)) continue;
+    if (end_speed > max_speed) {
+      body.angular_momentum *= max_speed / end_speed;
+      body.UpdateDerived();
+    }
+    if (start_speed > max_speed) body.start_angular_momentum *= max_speed / start_speed;
+  }
+}
+
 // The awake bodies drift over the step; each one's path (start, end and
 // velocities) is kept for the time-of-impact search. paths_ is kept between
 // steps, so that a step neither allocates nor clears a path per body.
 void WorldImpl::DriftBodies(double dt) {
+  CapSpin(dt);
   paths_.resize(bodies_.size());
   for (const std::uint32_t i : moving_bodies_) {
     const Body& body = bodies_[i];

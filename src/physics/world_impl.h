@@ -124,6 +124,7 @@ class WorldImpl {
   void ReportSleepingContacts(double dt);
   void IntegrateBodies(double dt);  // 5. integrator: drift, time of impact, sleep
   // Stage 5's parts (step_integrator.cc, step_impacts.cc).
+  void CapSpin(double dt);
   void DriftBodies(double dt);
   void BoundBodyMotion(double dt);
   std::vector<Impact> FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs);

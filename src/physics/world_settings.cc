@@ -65,6 +65,10 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
               ? Status::Ok()
               : Status::Error("continuous_fraction " + FormatNumber(fraction) +
                               " must be in (0, 1]"),
+          settings.max_turn_per_step > 0.0 && settings.max_turn_per_step <= M_PI
+              ? Status::Ok()
+              : Status::Error("max_turn_per_step " + FormatNumber(settings.max_turn_per_step) +
+                              " rad must be in (0, pi]"),
           // Speeds may be infinite: every body may then sleep.
           sleep.linear_velocity >= 0.0
               ? Status::Ok()

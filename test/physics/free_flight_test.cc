@@ -145,5 +145,40 @@ TEST(FreeFlightTest, SpinningCubeTurnsByOmegaTimesTimeAboutOmega) {
   EXPECT_LT(world.GetPose(id).translation.norm(), 1e-15);
 }
 
+// A spin faster than max_turn_per_step / dt is scaled down to it, about the
+// same axis, before the drift; the cube (all moments equal) then turns by
+// exactly max_turn each step. A spin just below the cap is left alone.
+TEST(FreeFlightTest, SpinBeyondAQuarterTurnPerStepIsCappedAboutItsAxis) {
+  WorldSettings settings;
+  settings.gravity = Vec3::Zero();
+  World world(settings);
+  const double max_speed = settings.max_turn_per_step / settings.time_step;  // rad/s
+  const Vec3 axis = Vec3(1.0, -2.0, 0.5).normalized();
+  BodyDef fast = BoxBody(Vec3::Constant(0.04), 1500.0);
+  fast.angular_velocity = 1e5 * axis;
+  const BodyId fast_id = world.CreateBody(fast).value();
+  BodyDef slow = BoxBody(Vec3::Constant(0.04), 1500.0);
+  slow.world_from_body.translation = Vec3(1.0, 0.0, 0.0);
+  slow.angular_velocity = 0.999 * max_speed * axis;
+  const BodyId slow_id = world.CreateBody(slow).value();
+  world.Step();
+
+  EXPECT_NEAR(world.GetAngularVelocity(fast_id).norm(), max_speed, 1e-9 * max_speed);
+  EXPECT_LT(world.GetAngularVelocity(fast_id).normalized().cross(axis).norm(), 1e-12);
+  const Quat turned(Eigen::AngleAxisd(settings.max_turn_per_step, axis));
+  EXPECT_LT(world.GetPose(fast_id).rotation.angularDistance(turned), 1e-9);
+  EXPECT_LT((world.GetAngularVelocity(slow_id) - slow.angular_velocity).norm(), 1e-9);
+}
+
+TEST(FreeFlightTest, MaxTurnPerStepOutsideItsRangeIsRefused) {
+  for (const double turn : {0.0, -1.0, 3.2, std::nan("")}) {
+    WorldSettings settings;
+    settings.max_turn_per_step = turn;
+    const Status status = ValidateWorldSettings(settings);
+    EXPECT_FALSE(status.ok()) << turn;
+    EXPECT_NE(status.message().find("max_turn_per_step"), std::string::npos) << status.message();
+  }
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::physics
