@@ -131,16 +131,15 @@ bool NormalInRegion(const CollisionMesh& mesh, int triangle_index, bool back,
 }
 
 // One group of contacts with similar normals: its first member's normal
-// decides who joins, and the sum of the members' normals, one per point,
-// is its normal. The mean keeps a body lying across a gentle ridge (two
-// facets a few degrees apart) from being pushed along one facet's normal
-// and then the other's as its deepest point changes side, which rocked it.
+// decides who joins. Each point keeps the normal of the triangle that made
+// it, so that the group's normal can be taken over the points that can
+// touch within the step (SupportOfGroup).
 struct Group {
   Vec3 normal_world = Vec3::UnitZ();
-  Vec3 normal_sum = Vec3::Zero();
   int first_triangle = 0;
   double deepest = std::numeric_limits<double>::infinity();
   std::vector<ContactPoint> points;
+  std::vector<Vec3> point_normals_world;  // unit, one per point
 };
 
 // Adds a triangle's manifold to the group whose normal is within
@@ -158,13 +157,12 @@ void AddToGroups(const ContactManifold& manifold, int triangle, std::vector<Grou
     if (*group_count == static_cast<int>(groups->size())) groups->emplace_back();
     group = &(*groups)[(*group_count)++];
     group->normal_world = manifold.normal_world;
-    group->normal_sum = Vec3::Zero();
     group->first_triangle = triangle;
     group->deepest = std::numeric_limits<double>::infinity();
     group->points.clear();
+    group->point_normals_world.clear();
   }
   group->first_triangle = std::min(group->first_triangle, triangle);
-  group->normal_sum += manifold.point_count * manifold.normal_world;
   for (int i = 0; i < manifold.point_count; ++i) {
     ContactPoint point = manifold.points[i];
     // Points of different triangles must not share an id: the triangle goes
@@ -173,7 +171,42 @@ void AddToGroups(const ContactManifold& manifold, int triangle, std::vector<Grou
                                                        (point.feature.index_b & 15u));
     group->deepest = std::min(group->deepest, point.separation);
     group->points.push_back(point);
+    group->point_normals_world.push_back(manifold.normal_world);
   }
+}
+
+// The manifold of a group: its normal and at most four points, taken from
+// the points that can touch within the step, those whose separation is
+// below `reach` (the most the two shapes can close in a step), or from all
+// of them when none can. Over a curved mesh a group holds points from
+// penetrating to the contact distance apart (5 mm and more); the reduction
+// keeps the deepest point and then the points spanning the largest area,
+// so it would give the slots to far corners that cannot carry load this
+// step and drop a point a fraction of a millimetre away on which the body
+// is about to pivot, which then sinks unseen for a step and is met late.
+// The normal is the mean of the normals of the triangles under the kept
+// candidates, one per point, so that it is the normal of the surface the
+// body rests on, not of triangles the contact distance away, which come
+// and go as the body rocks. The mean keeps a body lying across a gentle
+// ridge (two facets a few degrees apart) from being pushed along one
+// facet's normal and then the other's as its deepest point changes side.
+// Reduction: ReduceContactPoints (deepest point, then largest support
+// polygon); the restriction to points within reach is the speculative
+// contact's bound (Catto 2013, "Continuous Collision", GDC, speculative
+// contacts: a point further than the step's closing distance cannot touch
+// within the step).
+void SupportOfGroup(const Group& group, double reach, ContactManifold* manifold) {
+  thread_local std::vector<ContactPoint> candidates;
+  candidates.clear();
+  Vec3 normal_sum = Vec3::Zero();
+  const double limit = group.deepest < reach ? reach : std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < group.points.size(); ++i) {
+    if (group.points[i].separation > limit) continue;
+    candidates.push_back(group.points[i]);
+    normal_sum += group.point_normals_world[i];
+  }
+  ReduceContactPoints(candidates.data(), static_cast<int>(candidates.size()),
+                      normal_sum.normalized(), manifold);
 }
 
 // min over the convex shape of n . x, for a unit n in the shape's frame:
@@ -255,7 +288,8 @@ void MakeTrianglePrism(const std::array<Vec3, 3>& front_ccw, double depth,
 // normal; the kContactSlots groups with the deepest points are kept, the
 // deepest first and the others in the order of their first triangle (so a
 // group keeps its slot from step to step), and each is reduced to four
-// points.
+// points among those the shapes can reach within the step
+// (SupportOfGroup).
 namespace {
 
 // The triangles near a convex shape and how each one is collided with it.
@@ -388,8 +422,7 @@ void CollideConvexMesh(const ConvexMeshPair& pair, MeshContacts* contacts) {
   std::sort(kept.begin() + 1, kept.end(),
             [](const Group* x, const Group* y) { return x->first_triangle < y->first_triangle; });
   for (std::size_t s = 0; s < kept.size(); ++s) {
-    ReduceContactPoints(kept[s]->points.data(), static_cast<int>(kept[s]->points.size()),
-                        kept[s]->normal_sum.normalized(), &contacts->manifolds[s]);
+    SupportOfGroup(*kept[s], pair.reach, &contacts->manifolds[s]);
   }
   contacts->gap = -std::numeric_limits<double>::infinity();
 }

@@ -21,6 +21,10 @@ struct ConvexMeshPair {
   const CollisionMesh* mesh = nullptr;
   Pose world_from_mesh = Pose::Identity();
   double contact_distance = 0.0;  // m
+  // m; the most the shapes can close within the step (the contact distance
+  // less the margin): a group's support is taken from its points closer
+  // than this (CollideConvexMesh).
+  double reach = std::numeric_limits<double>::infinity();
 };
 
 struct MeshContacts {

@@ -130,12 +130,19 @@ void WorldImpl::UpdateNarrowPhase(double dt) {
 
 // m; the margin plus the distance the two bodies can close in one step.
 double WorldImpl::ContactDistance(const Body& a, const Body& b, double dt) const {
+  const double margin =
+      std::min(settings_.contact_margin, kMarginPerThickness * std::min(a.thickness, b.thickness));
+  return margin + ContactReach(a, b, dt);
+}
+
+// m; a bound on how far two points of the bodies can close in one step:
+// their relative speed, each body's turn times its bounding radius, and
+// gravity's half g dt^2.
+double WorldImpl::ContactReach(const Body& a, const Body& b, double dt) const {
   const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
                                a.angular_velocity.norm() * a.bounding_radius +
                                b.angular_velocity.norm() * b.bounding_radius;
-  const double margin =
-      std::min(settings_.contact_margin, kMarginPerThickness * std::min(a.thickness, b.thickness));
-  return margin + dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
+  return dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
 }
 
 // A face-defined manifold between polyhedra carried to the current poses
@@ -242,7 +249,7 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double
             {&contact_cache_, step_count_, &b.shapes, body_a, static_cast<std::uint16_t>(i), body_b,
              static_cast<int>(k), travel},
             {&shape_a.geometry, world_from_a * shape_a.body_from_shape, mesh->mesh.get(),
-             world_from_b * shape_b.body_from_shape, contact_distance});
+             world_from_b * shape_b.body_from_shape, contact_distance, ContactReach(a, b, dt)});
         continue;
       }
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,

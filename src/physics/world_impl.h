@@ -144,6 +144,7 @@ class WorldImpl {
   // Tests one listed shape pair: carries its manifold or clips a new one.
   void CollideShapePair(NarrowJob* job) const;
   double ContactDistance(const Body& a, const Body& b, double dt) const;
+  double ContactReach(const Body& a, const Body& b, double dt) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
