@@ -149,12 +149,15 @@ int ArticulationSolver::Solve(int max_sweeps, double tolerance) {
     double scale = 0.0;
     for (std::size_t k = 0; k < rows_.size(); ++k) {
       ConstraintRow& row = rows_[k];
-      if (row.inverse_mass == 0.0) continue;
+      // A tangent row is always taken with its pair, even one that moves
+      // nothing (a cart on a rail across it): skipping it alone would take
+      // its pair for the first of a pair, and the row after for its pair.
       if (row.kind == RowKind::kTangent) {
         largest = std::max(largest, UpdateFriction(k));
         ++k;  // its pair was updated with it
         continue;
       }
+      if (row.inverse_mass == 0.0) continue;
       const double velocity = RowVelocity(row);
       double next =
           row.impulse - row.inverse_mass * (velocity - row.target + row.softness * row.impulse);

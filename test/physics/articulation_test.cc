@@ -167,6 +167,41 @@ TEST(ArticulationTest, TiltedPrismaticAcceleratesAtGCosTheta) {
   }
 }
 
+// A cart on a level rail (a prismatic joint along x from a fixed base)
+// whose box touches the ground: the rail carries its weight, so the contact
+// has no normal impulse to give and, by Coulomb's law, no friction either;
+// the cart keeps its speed, x = v t. The contact's normal row and its first
+// tangent (along y) move nothing, only the second tangent does, so the
+// solver must still take the tangents as a pair: taken alone, the second
+// one read the row after the last (found by AddressSanitizer in the soak).
+TEST(ArticulationTest, CartOnALevelRailTouchingTheGroundKeepsItsSpeed) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(0.8, 0.0));
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.world_from_base.translation = Vec3(0.0, 0.0, 0.0499);  // the box 0.1 mm into the ground
+  LinkDef cart = Anchor();
+  ShapeDef box;
+  box.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3::Constant(0.1)));
+  box.material = MakeMaterial(0.8, 0.0);
+  cart.shapes.push_back(box);
+  def.links = {Anchor(), cart};
+  JointDef rail;
+  rail.name = "rail";
+  rail.type = JointType::kPrismatic;
+  rail.axis = Vec3::UnitX();
+  def.joints = {rail};
+  const ArticulationId id = world.CreateArticulation(def).value();
+  const double speed = 0.5;  // m/s
+  ASSERT_TRUE(world.SetJointStates(id, {0.0}, {speed}).ok());
+  const int steps = 240;
+  for (int step = 0; step < steps; ++step) world.Step();
+  const JointState state = world.GetJointStates(id)[0];
+  EXPECT_NEAR(state.velocity, speed, 1e-12);
+  EXPECT_NEAR(state.position, speed * steps * kDt, 1e-12);
+  EXPECT_FALSE(world.contacts().empty());  // it did touch the ground throughout
+}
+
 // Released 90 degrees from its lower limit, with gravity still pressing it
 // there, the arm stops at the limit: no overshoot beyond 1 mrad, no bounce.
 TEST(ArticulationTest, JointLimitStopsWithoutOvershootOrBounce) {
