@@ -367,6 +367,7 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"contact_reuse_distance", &world.contact_reuse_distance},
       {"threads", &world.threads},
       {"continuous_fraction", &world.continuous_fraction},
+      {"max_turn_per_step", &world.max_turn_per_step},
       {"solver/velocity_iterations", &solver.velocity_iterations},
       {"solver/velocity_tolerance", &solver.velocity_tolerance},
       {"solver/position_iterations", &solver.position_iterations},

@@ -39,6 +39,12 @@ TEST(OptionsTest, BadValuesAreNamed) {
   EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads -1 is outside [0, 256]");
   options.world.threads = 257;
   EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads 257 is outside [0, 256]");
+  options = NodeOptions();
+  options.world.max_turn_per_step = 4.0;
+  EXPECT_NE(
+      ValidateNodeOptions(options).message().find("max_turn_per_step 4 rad must be in (0, pi]"),
+      std::string::npos)
+      << ValidateNodeOptions(options).message();
 }
 
 // ~threads defaults to one thread; 0 (every core) and 2 are valid.

@@ -30,17 +30,14 @@ struct NodeOptions {
   // ~gravity [x, y, z] (m/s^2, default [0, 0, -9.81]), ~time_step (s, > 0,
   // default 1/240), ~contact_margin (m, 0.005), ~contact_reuse_distance (m,
   // 1e-3), ~continuous_fraction ((0, 1],
-  // 0.25), ~solver/{velocity_iterations (20), velocity_tolerance (m/s,
-  // 1e-6), position_iterations (6),
-  // collision_velocity_threshold (m/s, 0.01), contact_tolerance (m, 1e-5),
-  // penetration_slop (m, 1e-4), position_correction (1/step, 0.2),
-  // max_collision_rounds (32), collision_iterations (30),
-  // max_pivoting_points (count, 32)} and
-  // ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity
-  // (rad/s, 0.1), time_to_sleep (s, 0.5), speeding_up_time (s, 0.2)}; see
-  // physics/world_settings.h. ~threads (count, [0, 256], default 1; 0:
-  // one per core) is the threads a step runs on; any count gives the same
-  // motion bit for bit.
+  // 0.25), ~max_turn_per_step (rad, (0, pi], pi/2), ~solver/{velocity_iterations (20),
+  // velocity_tolerance (m/s, 1e-6), position_iterations (6), collision_velocity_threshold (m/s,
+  // 0.01), contact_tolerance (m, 1e-5), penetration_slop (m, 1e-4), position_correction (1/step,
+  // 0.2), max_collision_rounds (32), collision_iterations (30), max_pivoting_points (count, 32)}
+  // and ~sleep/{enabled (true), linear_velocity (m/s, 0.05), angular_velocity (rad/s, 0.1),
+  // time_to_sleep (s, 0.5), speeding_up_time (s, 0.2)}; see physics/world_settings.h. ~threads
+  // (count, [0, 256], default 1; 0: one per core) is the threads a step runs on; any count gives
+  // the same motion bit for bit.
   physics::WorldSettings world = NodeWorldSettings();
   double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
   double publish_rate = 50.0;       // ~publish_rate: Hz of /tf, ~states, ~contacts, > 0
