@@ -158,8 +158,7 @@ void WorldImpl::CapSpin(double dt) {
     if (!body.awake || body.disabled) continue;
     const double end_speed = body.angular_velocity.norm();
     const double start_speed = (body.inverse_inertia_world * body.start_angular_momentum).norm();
-    // Written so that NaN passes on to the step guard unchanged.
-    if (!(end_speed > max_speed) && !(start_speed > max_speed)) continue;
+    // A NaN speed fails both tests and passes on to the step guard as is.
     if (end_speed > max_speed) {
       body.angular_momentum *= max_speed / end_speed;
       body.UpdateDerived();

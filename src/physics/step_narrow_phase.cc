@@ -217,6 +217,7 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double
   const Body& b = bodies_[body_b];
   if (SkipsPair(a, b)) return;
   const double contact_distance = ContactDistance(a, b, dt);
+  const double reach = ContactReach(a, b, dt);
   const double travel = a.travel + b.travel;
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;
   // The poses, made once and only for a pair that is looked at.
@@ -249,7 +250,7 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double
             {&contact_cache_, step_count_, &b.shapes, body_a, static_cast<std::uint16_t>(i), body_b,
              static_cast<int>(k), travel},
             {&shape_a.geometry, world_from_a * shape_a.body_from_shape, mesh->mesh.get(),
-             world_from_b * shape_b.body_from_shape, contact_distance, ContactReach(a, b, dt)});
+             world_from_b * shape_b.body_from_shape, contact_distance, reach});
         continue;
       }
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,

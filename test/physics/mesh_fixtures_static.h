@@ -1,16 +1,26 @@
-// Triangle meshes for the static-mesh tests and benchmarks: boxes as
+// Triangle meshes for the static-mesh tests: boxes as
 // triangles, tessellated floors, a bin, a table and a terrain.
 #ifndef RIGID_BODY_SIM_TEST_PHYSICS_MESH_FIXTURES_STATIC_H_
 #define RIGID_BODY_SIM_TEST_PHYSICS_MESH_FIXTURES_STATIC_H_
 
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <utility>
+
+#include <gtest/gtest.h>
 
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/mass_properties.h"
 
 namespace rigid_body_sim::physics::testing {
+
+// The collision mesh of `mesh`, which a test expects to be valid.
+inline std::shared_ptr<const CollisionMesh> Build(const TriangleMesh& mesh) {
+  Result<std::shared_ptr<const CollisionMesh>> built = CollisionMesh::Make(mesh);
+  EXPECT_TRUE(built.ok()) << built.message();
+  return built.value();
+}
 
 // Appends the closed box [lower, upper] as 12 outward triangles.
 inline void AppendBox(const Vec3& lower, const Vec3& upper, TriangleMesh* mesh) {

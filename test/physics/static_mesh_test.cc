@@ -26,15 +26,10 @@ using testing::AddBox;
 using testing::AddGround;
 using testing::AddSphere;
 using testing::BoxSpec;
+using testing::Build;
 using testing::MakeMaterial;
 using testing::SphereSpec;
 using testing::Translation;
-
-std::shared_ptr<const CollisionMesh> Build(const TriangleMesh& mesh) {
-  Result<std::shared_ptr<const CollisionMesh>> built = CollisionMesh::Make(mesh);
-  EXPECT_TRUE(built.ok()) << built.message();
-  return built.value();
-}
 
 BodyId AddStaticMesh(World* world, const TriangleMesh& mesh, const Material& material,
                      const Pose& world_from_mesh = Pose::Identity()) {

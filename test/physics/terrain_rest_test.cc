@@ -22,14 +22,9 @@ namespace {
 
 using testing::AddBox;
 using testing::BoxSpec;
+using testing::Build;
 using testing::MakeMaterial;
 using testing::Translation;
-
-std::shared_ptr<const CollisionMesh> Build(const TriangleMesh& mesh) {
-  Result<std::shared_ptr<const CollisionMesh>> built = CollisionMesh::Make(mesh);
-  EXPECT_TRUE(built.ok()) << built.message();
-  return built.value();
-}
 
 // A unit box lying level across a gentle ridge z = -0.01 |x| (both roof
 // faces within the 9 degrees of one group) touches it along the ridge line,
