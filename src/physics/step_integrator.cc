@@ -416,8 +416,8 @@ bool WorldImpl::UpdateSpeedingUp(double dt, Body* body) const {
 
 // Islands are the connected components of the contact graph through moving
 // bodies (union-find). An island sleeps when every body in it has been slower
-// than the thresholds, and not speeding up, for time_to_sleep; it costs
-// nothing until woken.
+// than the thresholds, or has kept within its sleep window, and not speeding
+// up, for time_to_sleep; it costs nothing until woken.
 void WorldImpl::UpdateSleep(double dt) {
   const SleepSettings& sleep = settings_.sleep;
   if (!sleep.enabled) return;
@@ -436,6 +436,9 @@ void WorldImpl::UpdateSleep(double dt) {
     }
   }
   std::vector<double> island_sleep_time(bodies_.size(), std::numeric_limits<double>::infinity());
+  sleep_windows_.resize(bodies_.size());
+  const SleepWindowLimits limits =
+      MakeSleepWindowLimits(sleep.linear_velocity, sleep.angular_velocity, sleep.time_to_sleep);
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
     if (!body.awake) continue;
@@ -445,8 +448,13 @@ void WorldImpl::UpdateSleep(double dt) {
         body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
         body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
     body.sleep_time = slow ? body.sleep_time + dt : 0.0;
+    // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
+    if (speeding_up) RestartSleepWindow(i);
+    const double still_time =
+        UpdateSleepWindow(body.WorldFromPrincipal(), limits, dt, &sleep_windows_[i]);
+    const double quiet_time = std::max(body.sleep_time, still_time);
     double& island = island_sleep_time[islands.Find(i)];
-    island = std::min(island, island_has_link[islands.Find(i)] ? 0.0 : body.sleep_time);
+    island = std::min(island, island_has_link[islands.Find(i)] ? 0.0 : quiet_time);
   }
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];

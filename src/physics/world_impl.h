@@ -17,6 +17,7 @@
 #include "physics/contact_cache.h"
 #include "physics/contact_solver.h"
 #include "physics/integrator.h"
+#include "physics/sleep_window.h"
 #include "physics/task_pool.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
@@ -108,6 +109,8 @@ class WorldImpl {
   Body& MutableBody(BodyId id);
   BodyId BodyIdOf(std::uint32_t index) const;
   void Wake(std::uint32_t body);
+  // Starts the body's sleep window again (it woke, was created or moved).
+  void RestartSleepWindow(std::uint32_t body);
   // Wakes every body that touched `body` in the last step.
   void WakeTouching(std::uint32_t body);
 
@@ -208,6 +211,7 @@ class WorldImpl {
   std::vector<std::uint8_t> push_state_;      // 0 not pushed, 1 along one normal, 2 several
   std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
   std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
+  std::vector<SleepWindow> sleep_windows_;    // the sleep test's, per body slot (UpdateSleep)
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
   std::vector<BodyId> non_finite_bodies_;

@@ -51,6 +51,10 @@ struct SolverSettings {
 
 Status ValidateSolverSettings(const SolverSettings& settings);
 
+// A body is slow when its speeds are below the thresholds, or when it has
+// gone nowhere for time_to_sleep: its centre of mass and two points
+// linear_velocity / angular_velocity from it have each stayed within a
+// sphere of radius linear_velocity * time_to_sleep / 2 (rocking in place).
 struct SleepSettings {
   bool enabled = true;
   double linear_velocity = 0.05;  // m/s; slower bodies may sleep
