@@ -17,6 +17,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <new>
 #include <string>
 
@@ -62,41 +63,70 @@ bool LimitSelf(rlim_t memory_bytes, double cpu_seconds) {
   return setrlimit(RLIMIT_CPU, &cpu_limit) == 0 && setrlimit(RLIMIT_CORE, &none) == 0;
 }
 
-// --triangles: the scaled triangles of the file.
-int ReplyTriangles(int argc, char** argv) {
+// What every mode takes: the file and its scale (the arguments after the
+// mode's flag), and the limits (the last three arguments).
+struct Request {
+  std::string path;
+  rigid_body_sim::physics::Vec3 scale;
+  unsigned long long memory_bytes = 0;
+  double cpu_seconds = 0.0;
+  unsigned long long max_file_bytes = 0;
+};
+
+Request ReadRequest(int argc, char** argv, int first) {
+  Request request;
+  request.path = argv[first];
+  request.scale = rigid_body_sim::physics::Vec3(std::strtod(argv[first + 1], nullptr),
+                                                std::strtod(argv[first + 2], nullptr),
+                                                std::strtod(argv[first + 3], nullptr));
+  request.memory_bytes = std::strtoull(argv[argc - 3], nullptr, 10);
+  request.cpu_seconds = std::strtod(argv[argc - 2], nullptr);
+  request.max_file_bytes = std::strtoull(argv[argc - 1], nullptr, 10);
+  return request;
+}
+
+// Limits the process, loads the file and replies with what `build` makes of
+// its triangles; an importer's exception, out of memory included, becomes
+// an error reply.
+int Serve(
+    const Request& request,
+    const std::function<Result<std::string>(const rigid_body_sim::physics::TriangleMesh&)>& build) {
   using rigid_body_sim::io::FormatErrorReply;
-  if (argc != 9) return Reply(FormatErrorReply("mesh helper: expected 8 arguments"), 2);
-  const std::string path = argv[2];
-  const rigid_body_sim::physics::Vec3 scale(
-      std::strtod(argv[3], nullptr), std::strtod(argv[4], nullptr), std::strtod(argv[5], nullptr));
-  const unsigned long long memory_bytes = std::strtoull(argv[6], nullptr, 10);
-  const double cpu_seconds = std::strtod(argv[7], nullptr);
-  const unsigned long long max_file_bytes = std::strtoull(argv[8], nullptr, 10);
-  if (!LimitSelf(static_cast<rlim_t>(memory_bytes), cpu_seconds)) {
+  if (!LimitSelf(static_cast<rlim_t>(request.memory_bytes), request.cpu_seconds)) {
     return Reply(FormatErrorReply("mesh helper: setrlimit failed"), 2);
   }
+  const std::string& path = request.path;
   try {
+    // The path is already resolved; take it as it is.
     const auto as_is = [](const std::string& uri) -> Result<std::string> { return uri; };
     const Result<rigid_body_sim::physics::TriangleMesh> mesh =
-        rigid_body_sim::io::LoadMesh(path, scale, as_is, max_file_bytes);
+        rigid_body_sim::io::LoadMesh(path, request.scale, as_is, request.max_file_bytes);
     if (!mesh.ok()) return Reply(FormatErrorReply(mesh.message()), 1);
-    return Reply(rigid_body_sim::io::FormatTrianglesReply(*mesh), 0);
+    const Result<std::string> reply = build(*mesh);
+    if (!reply.ok()) return Reply(FormatErrorReply("mesh '" + path + "': " + reply.message()), 1);
+    return Reply(*reply, 0);
   } catch (const std::bad_alloc&) {
     return Reply(FormatErrorReply("mesh '" + path + "': out of memory in the mesh helper (limit " +
-                                  std::to_string(memory_bytes) + " bytes)"),
+                                  std::to_string(request.memory_bytes) + " bytes)"),
                  1);
   } catch (const std::exception& error) {
     return Reply(FormatErrorReply("mesh '" + path + "': " + error.what()), 1);
   }
 }
 
+// --triangles: the scaled triangles of the file.
+int ReplyTriangles(int argc, char** argv) {
+  using rigid_body_sim::io::FormatErrorReply;
+  if (argc != 9) return Reply(FormatErrorReply("mesh helper: expected 8 arguments"), 2);
+  return Serve(ReadRequest(argc, argv, 2), [](const rigid_body_sim::physics::TriangleMesh& mesh) {
+    return Result<std::string>(rigid_body_sim::io::FormatTrianglesReply(mesh));
+  });
+}
+
 // --pieces: the mesh's convex pieces.
 int ReplyPieces(int argc, char** argv) {
   using rigid_body_sim::io::FormatErrorReply;
   if (argc != 18) return Reply(FormatErrorReply("mesh helper: expected 17 arguments"), 2);
-  const std::string path = argv[2];
-  const rigid_body_sim::physics::Vec3 scale(
-      std::strtod(argv[3], nullptr), std::strtod(argv[4], nullptr), std::strtod(argv[5], nullptr));
   const std::string rule_name = argv[6];
   if (rule_name != "auto" && rule_name != "always") {
     return Reply(FormatErrorReply("mesh helper: rule '" + rule_name + "' is not auto or always"),
@@ -111,29 +141,14 @@ int ReplyPieces(int argc, char** argv) {
   options.balance_weight = std::strtod(argv[12], nullptr);
   options.merge_volume = std::strtod(argv[13], nullptr);
   options.convex_ratio = std::strtod(argv[14], nullptr);
-  const unsigned long long memory_bytes = std::strtoull(argv[15], nullptr, 10);
-  const double cpu_seconds = std::strtod(argv[16], nullptr);
-  const unsigned long long max_file_bytes = std::strtoull(argv[17], nullptr, 10);
-  if (!LimitSelf(static_cast<rlim_t>(memory_bytes), cpu_seconds)) {
-    return Reply(FormatErrorReply("mesh helper: setrlimit failed"), 2);
-  }
-  try {
-    const auto as_is = [](const std::string& uri) -> Result<std::string> { return uri; };
-    const Result<rigid_body_sim::physics::TriangleMesh> mesh =
-        rigid_body_sim::io::LoadMesh(path, scale, as_is, max_file_bytes);
-    if (!mesh.ok()) return Reply(FormatErrorReply(mesh.message()), 1);
-    const auto rule = rule_name == "auto" ? rigid_body_sim::io::PiecesRule::kAuto
-                                          : rigid_body_sim::io::PiecesRule::kAlways;
-    const auto pieces = rigid_body_sim::io::ConvexPieces(*mesh, options, rule);
-    if (!pieces.ok()) return Reply(FormatErrorReply("mesh '" + path + "': " + pieces.message()), 1);
-    return Reply(rigid_body_sim::io::FormatPiecesReply(*pieces), 0);
-  } catch (const std::bad_alloc&) {
-    return Reply(FormatErrorReply("mesh '" + path + "': out of memory in the mesh helper (limit " +
-                                  std::to_string(memory_bytes) + " bytes)"),
-                 1);
-  } catch (const std::exception& error) {
-    return Reply(FormatErrorReply("mesh '" + path + "': " + error.what()), 1);
-  }
+  const auto rule = rule_name == "auto" ? rigid_body_sim::io::PiecesRule::kAuto
+                                        : rigid_body_sim::io::PiecesRule::kAlways;
+  return Serve(ReadRequest(argc, argv, 2),
+               [&](const rigid_body_sim::physics::TriangleMesh& mesh) -> Result<std::string> {
+                 const auto pieces = rigid_body_sim::io::ConvexPieces(mesh, options, rule);
+                 if (!pieces.ok()) return pieces.status();
+                 return rigid_body_sim::io::FormatPiecesReply(*pieces);
+               });
 }
 
 }  // namespace
@@ -147,35 +162,13 @@ int main(int argc, char** argv) {
     return ReplyPieces(argc, argv);
   }
   if (argc != 10) return Reply(FormatErrorReply("mesh helper: expected 9 arguments"), 2);
-  const std::string path = argv[1];
-  const rigid_body_sim::physics::Vec3 scale(
-      std::strtod(argv[2], nullptr), std::strtod(argv[3], nullptr), std::strtod(argv[4], nullptr));
   rigid_body_sim::io::HullOptions hull;
   hull.max_vertices = std::atoi(argv[5]);
   hull.degenerate_tolerance = std::strtod(argv[6], nullptr);
-  const unsigned long long memory_bytes = std::strtoull(argv[7], nullptr, 10);
-  const double cpu_seconds = std::strtod(argv[8], nullptr);
-  const unsigned long long max_file_bytes = std::strtoull(argv[9], nullptr, 10);
-  if (!LimitSelf(static_cast<rlim_t>(memory_bytes), cpu_seconds)) {
-    return Reply(FormatErrorReply("mesh helper: setrlimit failed"), 2);
-  }
-  try {
-    // The path is already resolved; take it as it is.
-    const auto as_is = [](const std::string& uri) -> Result<std::string> { return uri; };
-    const Result<rigid_body_sim::physics::TriangleMesh> mesh =
-        rigid_body_sim::io::LoadMesh(path, scale, as_is, max_file_bytes);
-    if (!mesh.ok()) return Reply(FormatErrorReply(mesh.message()), 1);
-    const Result<rigid_body_sim::physics::ConvexPolyhedron> built =
-        rigid_body_sim::io::ComputeConvexHull(mesh->vertices, hull);
-    if (!built.ok()) {
-      return Reply(FormatErrorReply("mesh '" + path + "': " + built.message()), 1);
-    }
-    return Reply(rigid_body_sim::io::FormatHullReply(*built), 0);
-  } catch (const std::bad_alloc&) {
-    return Reply(FormatErrorReply("mesh '" + path + "': out of memory in the mesh helper (limit " +
-                                  std::to_string(memory_bytes) + " bytes)"),
-                 1);
-  } catch (const std::exception& error) {
-    return Reply(FormatErrorReply("mesh '" + path + "': " + error.what()), 1);
-  }
+  return Serve(ReadRequest(argc, argv, 1),
+               [&](const rigid_body_sim::physics::TriangleMesh& mesh) -> Result<std::string> {
+                 const auto built = rigid_body_sim::io::ComputeConvexHull(mesh.vertices, hull);
+                 if (!built.ok()) return built.status();
+                 return rigid_body_sim::io::FormatHullReply(*built);
+               });
 }
