@@ -22,14 +22,17 @@ enum class FeatureType : std::uint8_t {
   kSphere = 3,      // a sphere's surface point; indices unused
 };
 
+// 32-bit indices: a static mesh's feature numbers its triangle (times 16,
+// plus the feature of the triangle's prism), and meshes of more than 4,096
+// triangles would otherwise give far-apart triangles the same id.
 struct FeatureId {
   FeatureType type = FeatureType::kSphere;
-  std::uint16_t index_a = 0;
-  std::uint16_t index_b = 0;
+  std::uint32_t index_a = 0;
+  std::uint32_t index_b = 0;
 
-  std::uint32_t Key() const {
-    return (static_cast<std::uint32_t>(type) << 30) ^ (static_cast<std::uint32_t>(index_a) << 15) ^
-           static_cast<std::uint32_t>(index_b);
+  std::uint64_t Key() const {
+    return (static_cast<std::uint64_t>(type) << 62) ^ (static_cast<std::uint64_t>(index_a) << 31) ^
+           static_cast<std::uint64_t>(index_b);
   }
   friend bool operator==(FeatureId x, FeatureId y) {
     return x.type == y.type && x.index_a == y.index_a && x.index_b == y.index_b;

@@ -132,7 +132,7 @@ bool CollideCylinderHalfSpace(const CylinderPair& pair, ContactManifold* manifol
     const double separation = normal.dot(point) - plane;
     if (!(separation < pair.contact_distance)) return;
     kept[count++] = {point - 0.5 * separation * normal, separation,
-                     FeatureId{FeatureType::kVertexFace, static_cast<std::uint16_t>(index), 0}};
+                     FeatureId{FeatureType::kVertexFace, static_cast<std::uint32_t>(index), 0}};
   };
   keep(incident.far_side, kCapPoints);
   for (int k = 0; k < kCapPoints; ++k) keep(incident.cap_rim[k], k);
@@ -349,8 +349,8 @@ void FaceManifold(const CylinderPair& pair, const PolyhedronInWorld& polyhedron,
       if (polygon == &side && point == incident.cap_rim[0]) continue;
       const double separation = normal.dot(point) - plane;
       if (separation < pair.contact_distance) {
-        const FeatureId feature{FeatureType::kVertexFace, static_cast<std::uint16_t>(index),
-                                static_cast<std::uint16_t>(axis.face)};
+        const FeatureId feature{FeatureType::kVertexFace, static_cast<std::uint32_t>(index),
+                                static_cast<std::uint32_t>(axis.face)};
         points->push_back({point - 0.5 * separation * normal, separation, feature});
       }
       ++index;
@@ -371,7 +371,7 @@ void CapManifold(const CylinderPair& pair, const WorldCylinder& cylinder,
     const Vec3 radial = offset - offset.dot(cylinder.axis) * cylinder.axis;
     const double separation = cap_plane - normal.dot(vertex);
     if (radial.norm() <= cylinder.radius && separation < pair.contact_distance) {
-      const FeatureId feature{FeatureType::kFaceVertex, 0, static_cast<std::uint16_t>(v)};
+      const FeatureId feature{FeatureType::kFaceVertex, 0, static_cast<std::uint32_t>(v)};
       points->push_back({vertex + 0.5 * separation * normal, separation, feature});
     }
   }

@@ -167,8 +167,8 @@ void AddToGroups(const ContactManifold& manifold, int triangle, std::vector<Grou
     ContactPoint point = manifold.points[i];
     // Points of different triangles must not share an id: the triangle goes
     // into B's index (the prism's features number below 16).
-    point.feature.index_b = static_cast<std::uint16_t>(static_cast<unsigned>(triangle) * 16u +
-                                                       (point.feature.index_b & 15u));
+    point.feature.index_b =
+        static_cast<std::uint32_t>(triangle) * 16u + (point.feature.index_b & 15u);
     group->deepest = std::min(group->deepest, point.separation);
     group->points.push_back(point);
     group->point_normals_world.push_back(manifold.normal_world);

@@ -22,21 +22,21 @@ struct ClipVertex {
 
 FeatureId MakeFeatureId(const ClipVertex& vertex, const FaceContactInput& input,
                         int incident_face) {
-  const auto u16 = [](int i) { return static_cast<std::uint16_t>(i); };
+  const auto u32 = [](int i) { return static_cast<std::uint32_t>(i); };
   const int reference_face = input.reference_face;
   switch (vertex.kind) {
     case ClipVertex::Kind::kIncidentVertex:
       return input.reference_is_a
-                 ? FeatureId{FeatureType::kFaceVertex, u16(reference_face), u16(vertex.incident)}
-                 : FeatureId{FeatureType::kVertexFace, u16(vertex.incident), u16(reference_face)};
+                 ? FeatureId{FeatureType::kFaceVertex, u32(reference_face), u32(vertex.incident)}
+                 : FeatureId{FeatureType::kVertexFace, u32(vertex.incident), u32(reference_face)};
     case ClipVertex::Kind::kEdgeCrossing:
       return input.reference_is_a
-                 ? FeatureId{FeatureType::kEdgeEdge, u16(vertex.reference), u16(vertex.incident)}
-                 : FeatureId{FeatureType::kEdgeEdge, u16(vertex.incident), u16(vertex.reference)};
+                 ? FeatureId{FeatureType::kEdgeEdge, u32(vertex.reference), u32(vertex.incident)}
+                 : FeatureId{FeatureType::kEdgeEdge, u32(vertex.incident), u32(vertex.reference)};
     case ClipVertex::Kind::kReferenceVertex:
       return input.reference_is_a
-                 ? FeatureId{FeatureType::kVertexFace, u16(vertex.reference), u16(incident_face)}
-                 : FeatureId{FeatureType::kFaceVertex, u16(incident_face), u16(vertex.reference)};
+                 ? FeatureId{FeatureType::kVertexFace, u32(vertex.reference), u32(incident_face)}
+                 : FeatureId{FeatureType::kFaceVertex, u32(incident_face), u32(vertex.reference)};
   }
   return FeatureId{};
 }
@@ -247,8 +247,8 @@ bool BuildEdgeContact(const PolyhedronPair& pair, int edge_a, int edge_b, double
   manifold->normal_world = normal_world;
   manifold->points[0].position_world = 0.5 * (on_a + on_b);
   manifold->points[0].separation = separation;
-  manifold->points[0].feature = {FeatureType::kEdgeEdge, static_cast<std::uint16_t>(edge_a),
-                                 static_cast<std::uint16_t>(edge_b)};
+  manifold->points[0].feature = {FeatureType::kEdgeEdge, static_cast<std::uint32_t>(edge_a),
+                                 static_cast<std::uint32_t>(edge_b)};
   manifold->point_count = 1;
   return true;
 }

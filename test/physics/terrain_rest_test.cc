@@ -65,6 +65,41 @@ TEST(TerrainRestTest, MeshGroupKeepsPointsWithinReach) {
   EXPECT_NEAR(highest, 0.5 * slope - 1e-4 + 0.05 * slope, 1e-9);
 }
 
+// A contact point's feature names its triangle in B's index (the
+// triangle's place in the mesh's tree order x 16, plus the feature of the
+// triangle's prism), so that the contact cache tells points of different
+// triangles apart on meshes of any size. A box rests on the one triangle
+// near the origin of 10,001 (5,000 far off on either side, so the tree puts
+// it near the middle, past 4,096): its features name that triangle, not its
+// place mod 4,096 as a 16-bit index did.
+TEST(TerrainRestTest, ContactFeaturesNameTrianglesBeyond4096) {
+  constexpr int kSide = 5000;
+  TriangleMesh mesh;
+  for (int t = -kSide; t <= kSide; ++t) {
+    const Vec3 origin = t == 0 ? Vec3(-2.0, -2.0, 0.0) : Vec3(100.0 * t, 0.0, 0.0);
+    const int first = static_cast<int>(mesh.vertices.size());
+    mesh.vertices.push_back(origin);
+    mesh.vertices.push_back(origin + Vec3(6.0, 0.0, 0.0));
+    mesh.vertices.push_back(origin + Vec3(0.0, 6.0, 0.0));
+    mesh.triangles.emplace_back(first, first + 1, first + 2);
+  }
+  const std::shared_ptr<const CollisionMesh> ground = Build(mesh);
+  std::uint32_t under = 0;
+  while (ground->vertices()[ground->triangles()[under].vertices[0]].norm() > 10.0) ++under;
+  ASSERT_GE(under, 4096u);
+  const ShapeGeometry box =
+      std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3::Ones()));
+  ConvexMeshPair pair{&box, Translation(0.0, 0.0, 0.5 - 1e-4), ground.get(), Pose::Identity(),
+                      0.01};
+  MeshContacts contacts;
+  CollideConvexMesh(pair, &contacts);
+  const ContactManifold& manifold = contacts.manifolds[0];
+  ASSERT_EQ(manifold.point_count, 4);
+  for (int i = 0; i < manifold.point_count; ++i) {
+    EXPECT_EQ(manifold.points[i].feature.index_b / 16u, under) << i;
+  }
+}
+
 // The benchmark's hills (terrain_100): z = 0.5 sin(x / 3) cos(y / 3) m, as a
 // grid of 40/224 m cells, here a 4.1 m square patch of it.
 constexpr double kCell = 40.0 / 224.0;  // m
