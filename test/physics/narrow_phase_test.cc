@@ -99,7 +99,7 @@ TEST(NarrowPhaseBoxTest, FaceOnFaceOffsetGivesOverlapRectangleCorners) {
     ExpectPointsAt(manifold, corners, kExact);
     EXPECT_NEAR((manifold.normal_world - world_from_scene.rotation * Vec3::UnitZ()).norm(), 0.0,
                 kExact);
-    std::set<std::uint32_t> keys;
+    std::set<std::uint64_t> keys;
     for (int i = 0; i < manifold.point_count; ++i) {
       EXPECT_NEAR(manifold.points[i].separation, -0.01, kExact);
       keys.insert(manifold.points[i].feature.Key());
