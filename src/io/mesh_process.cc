@@ -153,8 +153,10 @@ Result<HelperRun> RunHelper(const std::vector<std::string>& arguments,
                         std::chrono::duration<double>(2.0 * limits.cpu_seconds + 1.0);
   char buffer[65536];
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    // Rounded up: truncated, the last fraction of a millisecond counted as
+    // none left and the helper was killed before its deadline.
+    const auto left =
+        std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0 || run.reply.size() > kMaxReplyBytes) {
       ::kill(pid, SIGKILL);
       run.timed_out = left.count() <= 0;

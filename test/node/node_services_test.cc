@@ -289,7 +289,8 @@ TEST_F(NodeServicesTest, SpawnIntoOverlapIsReportedAndSeparatesWithoutLaunching)
   const double limit = std::sqrt(2.0 * 9.81 * 0.05) + 0.1;
   double fastest = 0.0;
   for (int step = 0; step < 480; ++step) {
-    ASSERT_TRUE(client_.Step(1).success);
+    const auto stepped = client_.Step(1);
+    ASSERT_TRUE(stepped.success) << stepped.message;
     const auto state = client_.GetState("sunk_box");
     const auto& v = state.twist.linear;
     fastest = std::max(fastest, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
