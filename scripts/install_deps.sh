@@ -9,7 +9,7 @@ packages=(
   libtf2-ros-dev liburdfdom-dev liburdf-dev libdiagnostic-updater-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev libvisualization-msgs-dev libsensor-msgs-dev
-  libassimp-dev libqhull-dev libeigen3-dev libjemalloc2
+  libassimp-dev libqhull-dev libeigen3-dev
   libgtest-dev googletest librostest-dev python3-rostest python3-rosunit rosbash
   libbullet-dev libbenchmark-dev python3-matplotlib
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick

@@ -53,6 +53,7 @@ Result<int> SortAndSweepBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind k
   // Ids chosen by the caller may have taken entries of the free list since
   // they were pushed; drop those lazily.
   while (!free_ids_.empty() && proxies_[free_ids_.back()].in_use) {
+    proxies_[free_ids_.back()].in_free_list = false;
     free_ids_.pop_back();
   }
   const std::size_t id = free_ids_.empty() ? proxies_.size() : free_ids_.back();
@@ -80,14 +81,18 @@ Status SortAndSweepBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, Pr
   }
   const auto slot = static_cast<std::uint32_t>(id);
   if (slot >= proxies_.size()) {
-    // Smallest gap id on top, so AddProxy() hands out low ids first.
-    for (std::uint32_t gap = slot; gap-- > proxies_.size();) {
-      free_ids_.push_back(gap);
-    }
+    const auto old_size = static_cast<std::uint32_t>(proxies_.size());
     proxies_.resize(slot + 1);
+    // Smallest gap id on top, so AddProxy() hands out low ids first.
+    for (std::uint32_t gap = slot; gap-- > old_size;) {
+      free_ids_.push_back(gap);
+      proxies_[gap].in_free_list = true;
+    }
   }
   Proxy& proxy = proxies_[slot];
+  const bool listed = proxy.in_free_list;
   proxy = Proxy{};
+  proxy.in_free_list = listed;
   proxy.aabb_world = aabb_world;
   proxy.kind = kind;
   proxy.in_use = true;
@@ -129,7 +134,10 @@ Status SortAndSweepBroadPhase::RemoveProxy(int id) {
   dead_endpoint_count_ += 2;
   proxy.in_use = false;
   proxy.pending = false;
-  free_ids_.push_back(slot);
+  if (!proxy.in_free_list) {
+    free_ids_.push_back(slot);
+    proxy.in_free_list = true;
+  }
   --proxy_count_;
   return Status::Ok();
 }

@@ -95,6 +95,8 @@ class SortAndSweepBroadPhase {
 
   bool Contains(int id) const;
   std::size_t ProxyCount() const { return proxy_count_; }
+  // Entries of the free-id list; never more than the ids ever used.
+  std::size_t FreeIdCount() const { return free_ids_.size(); }
   const Aabb& GetAabb(int id) const;  // id must be in use (asserted)
   ProxyKind GetKind(int id) const;    // id must be in use (asserted)
 
@@ -130,6 +132,9 @@ class SortAndSweepBroadPhase {
     // Added since the last Update(): its endpoints sit unsorted at the end
     // of the lists and it is in no pair yet.
     bool pending = false;
+    // Its id is in free_ids_ (at most once, so the list never outgrows the
+    // slots however often ids chosen by the caller are removed and reused).
+    bool in_free_list = false;
   };
 
   static bool Precedes(const Endpoint& a, const Endpoint& b) {
@@ -158,8 +163,10 @@ class SortAndSweepBroadPhase {
   void AddPair(std::uint64_t key);
   void ErasePair(std::uint64_t key);
 
-  std::vector<Proxy> proxies_;                      // indexed by id
-  std::vector<std::uint32_t> free_ids_;             // ids below proxies_.size() not in use
+  std::vector<Proxy> proxies_;  // indexed by id
+  // Ids below proxies_.size() that were free when listed; AddProxy drops
+  // the ones AddProxyWithId has taken since.
+  std::vector<std::uint32_t> free_ids_;
   std::array<std::vector<Endpoint>, 3> endpoints_;  // per axis, sorted after Update()
   std::vector<std::uint32_t> pending_ids_;          // added since the last Update()
   std::unordered_set<std::uint64_t> pairs_;         // PairKey of each reported pair

@@ -164,6 +164,32 @@ TEST(SortAndSweepBroadPhaseTest, IdsChosenOrHandedOut) {
   EXPECT_EQ(broad_phase.ProxyCount(), 5u);
 }
 
+// The world gives each body's proxy the body's slot as its id, and a
+// removed body's slot is reused: 10,000 removals and re-additions of three
+// ids keep at most three entries in the free list (each removal used to add
+// one, 4 bytes a deleted body for the node's lifetime), and AddProxy still
+// hands out the lowest id not in use.
+TEST(SortAndSweepBroadPhaseTest, ReusedIdsDoNotGrowTheFreeList) {
+  SortAndSweepBroadPhase broad_phase;
+  for (int id = 0; id < 3; ++id) {
+    ASSERT_TRUE(
+        broad_phase.AddProxyWithId(id, UnitCubeAt(Vec3(2.0 * id, 0, 0)), ProxyKind::kDynamic).ok());
+  }
+  for (int round = 0; round < 10000; ++round) {
+    const int id = round % 3;
+    ASSERT_TRUE(broad_phase.RemoveProxy(id).ok());
+    broad_phase.Update();
+    ASSERT_TRUE(
+        broad_phase.AddProxyWithId(id, UnitCubeAt(Vec3(2.0 * id, 0, 0)), ProxyKind::kDynamic).ok());
+    broad_phase.Update();
+  }
+  EXPECT_LE(broad_phase.FreeIdCount(), 3u);
+  ASSERT_TRUE(broad_phase.RemoveProxy(1).ok());
+  EXPECT_EQ(broad_phase.AddProxy(UnitCubeAt(Vec3(9, 9, 9)), ProxyKind::kDynamic).value(), 1);
+  EXPECT_EQ(broad_phase.AddProxy(UnitCubeAt(Vec3(9, 9, 9)), ProxyKind::kDynamic).value(), 3);
+  EXPECT_EQ(broad_phase.ProxyCount(), 4u);
+}
+
 TEST(SortAndSweepBroadPhaseTest, RefusesBadInputAndKeepsState) {
   SortAndSweepBroadPhase broad_phase;
   const int id = broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic).value();
