@@ -27,10 +27,21 @@ inline bool PositiveFinite(double value) { return std::isfinite(value) && value 
 // document is parsed, its messages are collected here so they can go into
 // the returned error instead of the process log. The output handler is
 // global, so parses are serialised.
+//
+// Muted, console_bridge formats nothing: urdfdom hands some text from the
+// document to printf as the format itself (a bad <color rgba>, for one), so
+// a '%' in the document would be read as conversions with no arguments.
 class ConsoleCapture : public console_bridge::OutputHandler {
  public:
-  ConsoleCapture() : lock_(Mutex()) { console_bridge::useOutputHandler(this); }
-  ~ConsoleCapture() override { console_bridge::restorePreviousOutputHandler(); }
+  enum class Mode { kCapture, kMuted };
+  explicit ConsoleCapture(Mode mode) : lock_(Mutex()), level_(console_bridge::getLogLevel()) {
+    console_bridge::useOutputHandler(this);
+    if (mode == Mode::kMuted) console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+  }
+  ~ConsoleCapture() override {
+    console_bridge::setLogLevel(level_);
+    console_bridge::restorePreviousOutputHandler();
+  }
   ConsoleCapture(const ConsoleCapture&) = delete;
   ConsoleCapture& operator=(const ConsoleCapture&) = delete;
 
@@ -48,6 +59,7 @@ class ConsoleCapture : public console_bridge::OutputHandler {
     return mutex;
   }
   std::lock_guard<std::mutex> lock_;
+  console_bridge::LogLevel level_;
   std::string text_;
 };
 

@@ -86,22 +86,35 @@ class ModelBuilder {
       for_urdfdom = std::string(printer.CStr()) + std::string(16, '\0');
     }
 
-    urdf::ModelInterfaceSharedPtr model;
-    std::string parser_messages;
-    {
-      ConsoleCapture capture;
-      model = urdf::parseURDF(for_urdfdom);
-      parser_messages = capture.text();
-    }
+    urdf::ModelInterfaceSharedPtr model = ParseWithUrdfdom(for_urdfdom);
     if (model == nullptr) {
-      return Result<LoadedModel>::Error("urdfdom rejected the URDF: " + (parser_messages.empty()
-                                                                             ? "no reason given"
-                                                                             : parser_messages));
+      const std::string reason = UrdfdomMessages(for_urdfdom);
+      return Result<LoadedModel>::Error("urdfdom rejected the URDF: " +
+                                        (reason.empty() ? "no reason given" : reason));
     }
     return BuildModel(*model);
   }
 
  private:
+  // urdfdom's model of the document, parsed with console_bridge muted (see
+  // ConsoleCapture): nothing from the document reaches a printf format.
+  static urdf::ModelInterfaceSharedPtr ParseWithUrdfdom(const std::string& xml) {
+    ConsoleCapture muted(ConsoleCapture::Mode::kMuted);
+    return urdf::parseURDF(xml);
+  }
+
+  // Why urdfdom refused the document: parsed again with its messages
+  // captured, every '%' written as '?' first so none can act as a printf
+  // conversion in the messages that use document text as their format.
+  static std::string UrdfdomMessages(std::string xml) {
+    const bool replaced = xml.find('%') != std::string::npos;
+    std::replace(xml.begin(), xml.end(), '%', '?');
+    ConsoleCapture capture(ConsoleCapture::Mode::kCapture);
+    urdf::parseURDF(xml);
+    if (capture.text().empty() || !replaced) return capture.text();
+    return capture.text() + " (each '%' shown as '?')";
+  }
+
   Result<LoadedModel> BuildModel(const urdf::ModelInterface& model) {
     if (Status status = CheckJoints(model); !status.ok()) return status;
     for (const auto& [name, link] : model.links_) {
