@@ -166,22 +166,25 @@ TEST(UrdfHostileTest, PrintfConversionsInTheDocumentAreInert) {
   const std::string box = "<collision><geometry><box size='1 1 1'/></geometry></collision>";
 
   // urdfdom logs the bad colour and goes on; the name keeps its '%'.
-  const Result<LoadedModel> loaded = LoadUrdfString(
-      "<robot name='r" + conversions + "'><link name='base'><visual><geometry>"
-      "<box size='1 1 1'/></geometry><material name='m'><color rgba='" + conversions +
-      "'/></material></visual>" + box + "</link></robot>", UrdfLoadOptions{});
+  const Result<LoadedModel> loaded =
+      LoadUrdfString("<robot name='r" + conversions +
+                         "'><link name='base'><visual><geometry>"
+                         "<box size='1 1 1'/></geometry><material name='m'><color rgba='" +
+                         conversions + "'/></material></visual>" + box + "</link></robot>",
+                     UrdfLoadOptions{});
   ASSERT_TRUE(loaded.ok()) << loaded.message();
   EXPECT_EQ(loaded->name, "r" + conversions);
 
   // urdfdom refuses a bad calibration; the refusal still says why.
   const Result<LoadedModel> refused = LoadUrdfString(
       "<robot name='r'><link name='a'>" + box + "</link><link name='b'>" + box +
-      "</link><joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
-      "<limit lower='-1' upper='1' effort='1' velocity='1'/><calibration rising='" +
-      conversions + "'/></joint></robot>", UrdfLoadOptions{});
+          "</link><joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
+          "<limit lower='-1' upper='1' effort='1' velocity='1'/><calibration rising='" +
+          conversions + "'/></joint></robot>",
+      UrdfLoadOptions{});
   ASSERT_FALSE(refused.ok());
-  for (const char* word : {"urdfdom rejected the URDF", "rising value (?s?s?s", "[j]",
-                           "each '%' shown as '?'"}) {
+  for (const char* word :
+       {"urdfdom rejected the URDF", "rising value (?s?s?s", "[j]", "each '%' shown as '?'"}) {
     EXPECT_NE(refused.message().find(word), std::string::npos) << refused.message();
   }
 }
