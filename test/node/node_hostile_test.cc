@@ -149,6 +149,14 @@ TEST_F(NodeHostileTest, HostileSpawnsAreRefusedByField) {
                 {"<sphere> radius", "1e+300"}, "huge_sphere");
   ExpectRefused(SpawnXml("chain", Chain(10000)), {"10000 links", "max_links_per_model 1000"},
                 "chain");
+  // urdfdom would log this value as a printf format: "%s" read off the stack.
+  const std::string link = "<collision><geometry><box size='1 1 1'/></geometry></collision>";
+  ExpectRefused(SpawnXml("printf", "<robot name='printf'><link name='a'>" + link +
+                                       "</link><link name='b'>" + link +
+                                       "</link><joint name='j' type='continuous'><parent "
+                                       "link='a'/><child link='b'/><calibration rising='" +
+                                       "%s%s%s%s%s%s%s%s%s%s%s%s%n'/></joint></robot>"),
+                {"rising value", "?s?s?s?n"}, "printf");
   rigid_body_sim::Spawn::Request zero;
   zero.name = "zero";
   zero.urdf_path = "/dev/zero";
