@@ -76,12 +76,13 @@ void SortCounterClockwise(const std::vector<Vec3>& points, const Vec3& normal,
 }
 
 // Runs reentrant qhull (Barber, Dobkin, Huhdanpaa 1996, "The Quickhull
-// Algorithm for Convex Hulls") on the points selected by `ids`. The default
-// options pre-merge facets that are coplanar within round-off ('C-0'), so
-// flat regions come out as single non-simplicial facets. qh_new_qhull traps
+// Algorithm for Convex Hulls") on the points selected by `ids`, with the
+// qhull command line `options`. The default options pre-merge facets that are coplanar within
+// round-off ('C-0'), so flat regions come out as single non-simplicial facets. qh_new_qhull traps
 // qhull's internal errors with its own setjmp and returns an exit code; the
 // facet walk afterwards calls nothing that can raise an error.
-Result<RawHull> RunQhull(const std::vector<Vec3>& points, const std::vector<int>& ids) {
+Result<RawHull> RunQhull(const std::vector<Vec3>& points, const std::vector<int>& ids,
+                         const char* options = "qhull") {
   // Centring the coordinates keeps qhull's round-off small for meshes that
   // are far from their origin.
   Vec3 low = points[ids.front()];
@@ -102,9 +103,9 @@ Result<RawHull> RunQhull(const std::vector<Vec3>& points, const std::vector<int>
   qhT qh_storage;
   qhT* qh = &qh_storage;
   qh_zero(qh, errors.file());
-  char command[] = "qhull";
+  std::string command = options;
   const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(ids.size()), coordinates.data(), False,
-                                     command, nullptr, errors.file());
+                                     command.data(), nullptr, errors.file());
   std::optional<RawHull> hull;
   std::string failure;
   if (exit_code != 0) {
@@ -319,10 +320,38 @@ Result<ConvexPolyhedron> ToPolyhedron(const std::vector<Vec3>& points, const Raw
   return polyhedron;
 }
 
+// qhull's hull of the points selected by `ids`, as a polyhedron. qhull's
+// default merges only facets coplanar within round-off, so a dense, nearly
+// flat patch (a terrain-like sheet, a plate with a bump) can leave two
+// facets at an angle of 1e-4 rad, and a vertex on only those two that is
+// off their common edge by more than the polyhedron's plane tolerance. Such
+// a hull is retried with qhull's centrum pre-merge 'C-r' (qhull manual,
+// "Imprecision in Qhull": a facet whose centrum is within r of a
+// neighbour's hyperplane is merged into it), r growing from 1e-8 to 1e-6 of
+// the points' bounding-box diagonal: each hull vertex is still an input
+// point, and the merged facets are planar within the polyhedron's
+// tolerance.
 Result<ConvexPolyhedron> HullOf(const std::vector<Vec3>& points, const std::vector<int>& ids) {
   const Result<RawHull> hull = RunQhull(points, ids);
   if (!hull.ok()) return hull.status();
-  return ToPolyhedron(points, *hull);
+  Result<ConvexPolyhedron> polyhedron = ToPolyhedron(points, *hull);
+  if (polyhedron.ok()) return polyhedron;
+  Vec3 low = points[ids.front()];
+  Vec3 high = low;
+  for (int id : ids) {
+    low = low.cwiseMin(points[id]);
+    high = high.cwiseMax(points[id]);
+  }
+  const double diagonal = (high - low).norm();
+  for (const double relative_radius : {1e-8, 1e-7, 1e-6}) {
+    char options[64];
+    std::snprintf(options, sizeof(options), "qhull C-%.17g", relative_radius * diagonal);
+    const Result<RawHull> merged = RunQhull(points, ids, options);
+    if (!merged.ok()) continue;
+    Result<ConvexPolyhedron> retried = ToPolyhedron(points, *merged);
+    if (retried.ok()) return retried;
+  }
+  return polyhedron;
 }
 
 std::vector<int> Iota(size_t count) {
@@ -363,7 +392,7 @@ Result<ConvexPolyhedron> ComputeConvexHull(const std::vector<Vec3>& points,
   const Result<RawHull> full = RunQhull(points, all_ids);
   if (!full.ok()) return full.status();
   if (static_cast<int>(full->vertex_ids.size()) <= options.max_vertices) {
-    return ToPolyhedron(points, *full);
+    return HullOf(points, full->vertex_ids);
   }
   const Result<ConvexPolyhedron> simplified =
       HullOf(points, GrownLatticeSupports(points, full->vertex_ids, options.max_vertices));
