@@ -20,6 +20,12 @@ int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u, const Eigen::M
   return static_cast<int>(articulations_.size()) - 1;
 }
 
+int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u,
+                                        const Eigen::LLT<Eigen::MatrixXd>& mass) {
+  articulations_.push_back(ArticulationSlot{u, mass});
+  return static_cast<int>(articulations_.size()) - 1;
+}
+
 int ArticulationSolver::BodySlotOf(const BodySlot& body) {
   if (slot_of_body_.size() <= body.body) slot_of_body_.resize(body.body + 1, -1);
   int& slot = slot_of_body_[body.body];

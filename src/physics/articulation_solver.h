@@ -86,6 +86,8 @@ class ArticulationSolver {
 
   void Reset();
   int AddArticulation(const Eigen::VectorXd& u, const Eigen::MatrixXd& mass);
+  // As above, with the joint-space inertia already factored.
+  int AddArticulation(const Eigen::VectorXd& u, const Eigen::LLT<Eigen::MatrixXd>& mass);
   // The slot of a rigid body, added once.
   int BodySlotOf(const BodySlot& body);
   RowSide ArticulationSide(int slot, const Eigen::VectorXd& jacobian) const;

@@ -181,6 +181,7 @@ void WorldImpl::SolveArticulations(double dt) {
     entry.next =
         Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
   }
+  CorrectLinkPenetration(dt, slot);
   // A joint's effort: its command's, its rows' impulses over dt, less its
   // damping; shared with its mimics, each taking its multiplier's part.
   for (const ConstraintRow& row : articulation_solver_.rows()) {
@@ -230,12 +231,14 @@ void WorldImpl::SolveArticulations(double dt) {
 // normal row's target follows the rigid bodies' classification: a point
 // touching and closing faster than the collision threshold bounces with
 // restitution, v+ >= -e v-; one apart by s may close it within the step,
-// v+ >= -s / dt (so nothing passes through a link); one penetrating beyond
-// the slop is pushed out by position_correction of its depth per step.
+// v+ >= -s / dt (so nothing passes through a link); one penetrating stops
+// sinking, v+ >= 0, and beyond the slop is pushed out by the split impulse
+// (CorrectLinkPenetration), which moves positions only.
 void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
                                    const std::vector<ArticulationKinematics>& kinematics) {
   const SolverSettings& solver = settings_.solver;
   link_pair_rows_.assign(link_pairs_.size(), -1);
+  link_penetrations_.clear();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
     const ShapePairContact& pair = *link_pairs_[m];
     const Body& a = bodies_[pair.body_a];
@@ -283,11 +286,14 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
       } else if (separation > 0.0) {
         normal_row.target = -separation / dt;
       } else {
-        normal_row.target =
-            solver.position_correction * std::max(0.0, -separation - solver.penetration_slop) / dt;
+        normal_row.target = 0.0;
       }
+      const double depth = -separation - solver.penetration_slop;
       normal_row.impulse = pair.warm_start[i].normal_impulse;
       const int normal_index = articulation_solver_.AddRow(std::move(normal_row));
+      if (depth > 0.0) {
+        link_penetrations_.emplace_back(normal_index, solver.position_correction * depth / dt);
+      }
       if (i == 0) link_pair_rows_[m] = normal_index;
       for (int t = 0; t < 2; ++t) {
         ConstraintRow tangent_row;
@@ -300,6 +306,69 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
         articulation_solver_.AddRow(std::move(tangent_row));
       }
     }
+  }
+}
+
+// The split impulse of the link contacts (the rigid bodies' is in
+// resting_contact.cc): pseudo velocities from rest, found by projected
+// Gauss-Seidel on the penetrating points' normal rows alone with
+// J u_p >= position_correction depth / dt, move the articulations' joint
+// positions and base by dt u_p and the rigid bodies by their pseudo
+// velocities, and change no real velocity. A link spawned into the ground
+// is lifted out without a launch speed; pushing through its real velocity
+// (Baumgarte) would give it position_correction depth / dt of real speed and, on a spinning
+// chain, feed it. The split impulse of Bullet's sequential-impulse solver
+// (btSequentialImpulseConstraintSolver), in joint coordinates; the
+// projected Gauss-Seidel is Erleben 2007, section 3.
+void WorldImpl::CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation) {
+  if (link_penetrations_.empty()) return;
+  ArticulationSolver& pseudo = link_pseudo_solver_;
+  pseudo.Reset();
+  const std::vector<ArticulationSolver::ArticulationSlot>& velocity_slots =
+      articulation_solver_.articulations();
+  const std::vector<ArticulationSolver::BodySlot>& velocity_bodies = articulation_solver_.bodies();
+  std::vector<int> pseudo_slot(velocity_slots.size(), -1);
+  auto remap = [&](RowSide side) {
+    if (side.kind == RowSide::Kind::kArticulation) {
+      int& slot = pseudo_slot[side.slot];
+      if (slot < 0) {
+        const ArticulationSolver::ArticulationSlot& from = velocity_slots[side.slot];
+        slot = pseudo.AddArticulation(Eigen::VectorXd::Zero(from.u.size()), from.mass);
+      }
+      side.slot = slot;
+    } else if (side.kind == RowSide::Kind::kBody) {
+      // A rigid body starts from the pseudo velocity its own solve gave it.
+      ArticulationSolver::BodySlot body = velocity_bodies[side.slot];
+      body.linear_velocity = bodies_[body.body].pseudo_linear_velocity;
+      body.angular_velocity = bodies_[body.body].pseudo_angular_velocity;
+      side.slot = pseudo.BodySlotOf(body);
+    }
+    return side;
+  };
+  for (const auto& [index, target] : link_penetrations_) {
+    const ConstraintRow& from = articulation_solver_.rows()[index];
+    ConstraintRow row;
+    row.kind = RowKind::kNormal;
+    row.a = remap(from.a);
+    row.b = remap(from.b);
+    row.target = target;
+    pseudo.AddRow(std::move(row));
+  }
+  pseudo.Solve(kMaxSweeps, kSweepTolerance);
+
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    const int slot = slot_of_articulation[i];
+    if (slot < 0 || pseudo_slot[slot] < 0) continue;
+    ArticulationEntry& entry = articulations_[i];
+    const Eigen::VectorXd velocity = entry.next.u;
+    entry.next = Advance(entry.model, entry.next, pseudo.articulations()[pseudo_slot[slot]].u, dt);
+    entry.next.u = velocity;
+  }
+  for (const ArticulationSolver::BodySlot& slot_body : pseudo.bodies()) {
+    Body& body = bodies_[slot_body.body];
+    if (body.inverse_mass == 0.0 || !body.awake || body.disabled) continue;
+    body.pseudo_linear_velocity = slot_body.linear_velocity;
+    body.pseudo_angular_velocity = slot_body.angular_velocity;
   }
 }
 

@@ -177,6 +177,7 @@ class WorldImpl {
   void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
   void SolveArticulations(double dt);
   void AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free, double dt);
+  void CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation);
   void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
                           const std::vector<ArticulationKinematics>& kinematics);
   void ReportLinkContacts(double dt);
@@ -223,6 +224,11 @@ class WorldImpl {
   std::vector<ShapePairContact*> link_pairs_;
   // Per link pair, the index of its first normal row, or -1.
   std::vector<int> link_pair_rows_;
+  // The normal rows of link contacts penetrating beyond the slop, each with
+  // the speed that removes position_correction of that depth in one step,
+  // and the solver of their split impulse (CorrectLinkPenetration).
+  std::vector<std::pair<int, double>> link_penetrations_;
+  ArticulationSolver link_pseudo_solver_;
 };
 
 }  // namespace rigid_body_sim::physics
