@@ -153,7 +153,19 @@ Status CheckGeometry(const TiXmlElement& geometry, const std::string& where,
       Result<std::vector<double>> scale =
           NumbersIn(*shape, "scale", at, 3, -kMaxShapeSize, kMaxShapeSize, false);
       if (!scale.ok()) return scale.status();
+    } else {
+      // urdfdom drops such a collision without a word, and the model would
+      // fall through the floor where it was meant to touch.
+      return Status::Error(at + " is not a URDF collision geometry: use <box>, <cylinder>, " +
+                           "<sphere> or <mesh>" +
+                           (kind == "capsule" ? " (a capsule is a <cylinder> with a <sphere> "
+                                                "at each end, as three <collision>s)"
+                                              : ""));
     }
+  }
+  if (geometry.FirstChildElement() == nullptr) {
+    return Status::Error(where + " <geometry> is empty: it needs a <box>, <cylinder>, " +
+                         "<sphere> or <mesh>");
   }
   return Status::Ok();
 }

@@ -189,6 +189,17 @@ TEST(UrdfHostileTest, PrintfConversionsInTheDocumentAreInert) {
   }
 }
 
+// urdfdom drops a collision whose geometry it does not know, so the model
+// would load without it; the loader names the element instead.
+TEST(UrdfHostileTest, UnknownCollisionGeometryIsRefusedByName) {
+  ExpectRefused(OneLink("<capsule radius='0.1' length='0.5'/>"),
+                {"link 'base' <collision> 0 <capsule>", "not a URDF collision geometry",
+                 "<cylinder> with a <sphere> at each end"});
+  ExpectRefused(OneLink("<plane normal='0 0 1'/>"),
+                {"link 'base' <collision> 0 <plane>", "<box>, <cylinder>, <sphere> or <mesh>"});
+  ExpectRefused(OneLink(""), {"link 'base' <collision> 0 <geometry> is empty"});
+}
+
 TEST(UrdfHostileTest, DocumentEndingInAUtf8LeadByteIsRefused) {
   const Result<LoadedModel> model =
       LoadUrdfFile(std::string(RBS_TEST_DATA_DIR) + "/utf8_lead_byte_at_end.urdf");
