@@ -297,7 +297,11 @@ std::vector<int> GrownLatticeSupports(const std::vector<Vec3>& points,
 }
 
 // Builds the polyhedron of a qhull result; its vertices are copies of input
-// points.
+// points. The polyhedron must also build again from its own faces, as the
+// node builds it from the mesh helper's reply: merging and dropping
+// collinear vertices change the faces whose areas and planes are checked,
+// and a hull spanning 1e38 m passed the first build and failed the second
+// (mesh_parser_fuzzer).
 Result<ConvexPolyhedron> ToPolyhedron(const std::vector<Vec3>& points, const RawHull& hull) {
   std::vector<int> compact_index(points.size(), -1);
   std::vector<Vec3> vertices;
@@ -316,6 +320,17 @@ Result<ConvexPolyhedron> ToPolyhedron(const std::vector<Vec3>& points, const Raw
   if (!polyhedron.ok()) {
     return Result<ConvexPolyhedron>::Error("convex hull is not a valid polyhedron: " +
                                            polyhedron.message());
+  }
+  std::vector<std::vector<int>> own_faces;
+  own_faces.reserve(polyhedron->faces.size());
+  for (int face = 0; face < static_cast<int>(polyhedron->faces.size()); ++face) {
+    own_faces.push_back(polyhedron->FaceVertices(face));
+  }
+  const Result<ConvexPolyhedron> rebuilt =
+      physics::MakeConvexPolyhedron(polyhedron->vertices, own_faces);
+  if (!rebuilt.ok()) {
+    return Result<ConvexPolyhedron>::Error(
+        "convex hull is not a valid polyhedron once its faces are merged: " + rebuilt.message());
   }
   return polyhedron;
 }

@@ -289,6 +289,44 @@ TEST(ConvexHullTest, BumpySheetWithRoundOffHasItsHull) {
   }
 }
 
+// The node builds a hull again from the mesh helper's reply (its vertices
+// and merged faces), so a hull must build from its own faces. These 16
+// single-precision points spanning 1e-33 to 1e38 (found by
+// mesh_parser_fuzzer) gave one whose merged face was degenerate against the
+// second build's scale.
+TEST(ConvexHullTest, HullBuildsAgainFromItsOwnFaces) {
+  const std::vector<std::array<float, 3>> found = {
+      {7.67283654e+34f, 4.7417776e+30f, 2.06998394e-19f},
+      {1.71856889e+25f, 4.02739266e-11f, 1.10756849e+27f},
+      {1.77510793e+28f, 7.26438006e+22f, 1.86155902e+34f},
+      {8.48333114e-33f, 1.32919798e-14f, 7.68184349e+31f},
+      {1.11282515e+27f, 2.0699842e-19f, 4.75449973e+30f},
+      {4.54451143e+30f, 1.89454763e+23f, 7.14432799e+31f},
+      {1.7142145e+29f, 7.09639849e+22f, 2.11296489e-19f},
+      {2.76036423e+20f, 1.20431659e-32f, 4.43769426e+27f},
+      {2.07041304e-19f, 6.71108672e+22f, 1.71102294e+29f},
+      {7.09639849e+22f, 1.01546096e-08f, 6.29828023e-10f},
+      {6.63817332e-07f, 6.3369221e-10f, 8.72427663e-33f},
+      {8.45697633e+37f, 8.4570174e+37f, 1.01391588e-08f},
+      {4.00463725e-11f, 1.53479033e-19f, 6.33692931e-10f},
+      {8.72427663e-33f, 1.01390869e-08f, 4.00463725e-11f},
+      {1.53479033e-19f, 2.62529284e-06f, 5.02797026e-10f},
+      {1.53478994e-19f, 2.53477173e-09f, 9.10675875e-12f},
+  };
+  std::vector<Vec3> points;
+  for (const std::array<float, 3>& p : found) points.emplace_back(p[0], p[1], p[2]);
+  const physics::Result<ConvexPolyhedron> hull = ComputeConvexHull(points);
+  ASSERT_TRUE(hull.ok()) << hull.message();
+  std::vector<std::vector<int>> faces;
+  for (int face = 0; face < static_cast<int>(hull->faces.size()); ++face) {
+    faces.push_back(hull->FaceVertices(face));
+  }
+  const physics::Result<ConvexPolyhedron> again =
+      physics::MakeConvexPolyhedron(hull->vertices, faces);
+  ASSERT_TRUE(again.ok()) << again.message();
+  EXPECT_EQ(again->vertices, hull->vertices);
+}
+
 TEST(ConvexHullTest, QhullPrecisionFailureIsReportedNotRaised) {
   std::vector<Vec3> plate;
   for (int i = 0; i < 8; ++i) {
