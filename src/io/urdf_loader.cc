@@ -155,7 +155,13 @@ class ModelBuilder {
       loaded.warnings.push_back("every link has mass 0: the model is static");
     }
     loaded.root_link = body_root->name;
-    static_model_ = loaded.is_static || options_.spawn_static;
+    // Links below a movable joint move even when the base is fixed, so an
+    // articulated model's meshes are hulls or pieces, never triangles.
+    bool moving_links = false;
+    for (const auto& [name, joint] : model.joints_) {
+      moving_links = moving_links || (options_.articulate && IsWeldable(joint->type));
+    }
+    static_model_ = (loaded.is_static || options_.spawn_static) && !moving_links;
     meshes_.set_max_aspect_ratio(MaxAspectRatio(static_model_));
 
     std::vector<MassProperties> parts_in_root;

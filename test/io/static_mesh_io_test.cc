@@ -11,6 +11,7 @@
 #include "rigid_body_sim/io/mesh_loader.h"
 #include "rigid_body_sim/io/mesh_process.h"
 #include "rigid_body_sim/io/urdf_loader.h"
+#include "rigid_body_sim/physics/world.h"
 
 namespace rigid_body_sim::io {
 namespace {
@@ -113,6 +114,41 @@ TEST(StaticMeshIoTest, StaticModelsKeepTriangles) {
     ASSERT_TRUE(spawned.ok()) << spawned.message();
     EXPECT_TRUE(std::holds_alternative<physics::StaticMesh>(spawned->shapes[1].shape.geometry));
   }
+}
+
+// An arm fixed to the world (a UR5's habit) moves below its movable joint,
+// so when articulated its meshes collide as hulls or pieces, which a moving
+// link can carry: triangles were refused by the world for every published
+// UR description. Welded, the whole model is static and keeps triangles.
+TEST(StaticMeshIoTest, ArticulatedModelFixedToTheWorldHasNoTriangles) {
+  std::string xml = MeshModel(true, "");
+  xml.replace(xml.find("</robot>"), std::string::npos,
+              "<link name='arm'><inertial><mass value='1'/><inertia ixx='0.1' iyy='0.1' "
+              "izz='0.1' ixy='0' ixz='0' iyz='0'/></inertial><collision><geometry><box "
+              "size='0.1 0.1 0.5'/></geometry></collision></link><joint name='shoulder' "
+              "type='continuous'><parent link='base'/><child link='arm'/><origin "
+              "xyz='0 0 0.3'/><axis xyz='0 0 1'/></joint></robot>");
+  UrdfLoadOptions options = OutOfProcessOptions();
+  options.resolver = ResolvePackage;
+  options.articulate = true;
+  const Result<LoadedModel> articulated = LoadUrdfString(xml, options);
+  ASSERT_TRUE(articulated.ok()) << articulated.message();
+  for (const LoadedShape& shape : articulated->shapes) {
+    EXPECT_FALSE(std::holds_alternative<physics::StaticMesh>(shape.shape.geometry))
+        << shape.link_name;
+  }
+  const Result<physics::ArticulationDef> def = MakeArticulationDef(*articulated, nullptr);
+  ASSERT_TRUE(def.ok()) << def.message();
+  EXPECT_TRUE(def->fixed_base);
+  physics::World world;
+  const Result<physics::ArticulationId> created = world.CreateArticulation(*def);
+  EXPECT_TRUE(created.ok()) << created.message();
+
+  options.articulate = false;
+  options.weld_movable_joints = true;
+  const Result<LoadedModel> welded = LoadUrdfString(xml, options);
+  ASSERT_TRUE(welded.ok()) << welded.message();
+  EXPECT_TRUE(std::holds_alternative<physics::StaticMesh>(welded->shapes[0].shape.geometry));
 }
 
 TEST(StaticMeshIoTest, MeshCollisionPicksTrianglesOrHull) {
