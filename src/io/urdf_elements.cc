@@ -1,6 +1,8 @@
 #include "io/urdf_elements.h"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 
 namespace rigid_body_sim::io {
@@ -92,26 +94,41 @@ std::vector<std::string> FillOmittedProductsOfInertia(TiXmlElement* robot) {
 
 namespace {
 
-// Raises the two smaller principal moments of `inertia` by one factor until
-// I1 + I2 = I3, if they miss the triangle inequality by at most
-// kMaxTriangleDeficit of I3; keeps the principal axes. False when the
-// tensor is not positive definite or misses by more.
-bool BalanceInertia(Mat3* inertia) {
+// Repairs a tensor with non-negative moments about the axes that is not
+// positive definite or misses the triangle inequality I1 + I2 >= I3 of its
+// principal moments (CAD exports, sensor frames given 1e-6 everywhere):
+// keeping the principal axes, each moment is raised to at least
+// kMinMomentRatio of the largest, then I1 and I2 by one factor until
+// I1 + I2 = I3, a flat plate's moments, the nearest a rigid body can have.
+// Only a tensor that misses I1 + I2 >= I3 by at most `max_deficit` of I3
+// is repaired. Returns what was changed, or an empty string when nothing
+// was (a valid tensor, or one left for the validation to refuse).
+std::string RepairInertia(double max_deficit, Mat3* inertia) {
+  constexpr double kMinMomentRatio = 1e-3;
   const physics::PrincipalAxes axes = physics::ComputePrincipalAxes(*inertia);
-  Vec3 moments = axes.principal_moments;
+  const Vec3 before = axes.principal_moments;
+  if (before[0] + before[1] < (1.0 - max_deficit) * before[2]) return "";
+  Vec3 moments = before;
+  const double floor = kMinMomentRatio * moments[2];
+  for (int k = 0; k < 2; ++k) moments[k] = std::max(moments[k], floor);
   const double sum = moments[0] + moments[1];
-  if (!(moments[0] > 0.0) || sum >= moments[2]) return false;
-  if (moments[2] - sum > kMaxTriangleDeficit * moments[2]) return false;
-  moments.head<2>() *= moments[2] / sum;
+  if (sum < moments[2]) moments.head<2>() *= moments[2] / sum;
+  if (moments == before && before[0] > 0.0) return "";
   const Mat3 body_from_principal = axes.body_from_principal.toRotationMatrix();
   *inertia = body_from_principal * moments.asDiagonal() * body_from_principal.transpose();
-  return true;
+  const auto list = [](const Vec3& v) {
+    return "[" + FormatNumber(v[0]) + ", " + FormatNumber(v[1]) + ", " + FormatNumber(v[2]) + "]";
+  };
+  const bool definite = before[0] > 0.0;
+  return std::string(definite ? "misses I1 + I2 >= I3" : "is not positive definite") +
+         ": principal moments " + list(before) + " kg m^2 read as " + list(moments) +
+         " (same axes)";
 }
 
 }  // namespace
 
-Result<InertialReading> ReadInertial(const urdf::Link& link,
-                                     const MassProperties& geometry_in_link) {
+Result<InertialReading> ReadInertial(const urdf::Link& link, const MassProperties& geometry_in_link,
+                                     bool balance) {
   const urdf::Inertial& inertial = *link.inertial;
   const std::string where = "link " + Quoted(link.name);
   InertialReading reading;
@@ -131,7 +148,31 @@ Result<InertialReading> ReadInertial(const urdf::Link& link,
     return Result<InertialReading>::Error(where + ": invalid <inertial>: origin is not finite");
   }
   Pose link_from_com = link_from_inertial;
-  if (in_inertial_frame.inertia_about_com.isZero(0.0) && geometry_in_link.mass > 0.0) {
+  const Mat3& stated = in_inertial_frame.inertia_about_com;
+  // Round-off: entries below a micrometre's lever on the link's mass are
+  // read as 0 (iCub's ixx = iyy = -5.4e-20 kg m^2, izz = 0, for 0.526 kg),
+  // and a negative moment is refused only beyond it and beyond 1e-9 of the
+  // largest.
+  const double round_off = 1e-12 * inertial.mass;
+  const bool all_zero = stated.cwiseAbs().maxCoeff() <= round_off;
+  const double largest = stated.diagonal().cwiseAbs().maxCoeff();
+  for (int k = 0; k < 3 && !all_zero; ++k) {
+    if (stated(k, k) < -std::max(1e-9 * largest, round_off)) {
+      static const char* const kNames[] = {"ixx", "iyy", "izz"};
+      return Result<InertialReading>::Error(where + ": invalid <inertial>: " + kNames[k] + " " +
+                                            FormatNumber(stated(k, k)) +
+                                            " is negative; a moment of inertia is >= 0");
+    }
+  }
+  if (all_zero && geometry_in_link.mass <= 0.0) {
+    // No tensor and no geometry to take one from: a ball of water of that
+    // mass, 2/5 m r^2, so the link turns as a small solid does.
+    const double radius = std::cbrt(3.0 * inertial.mass / (4.0 * physics::kPi * 1000.0));
+    in_inertial_frame.inertia_about_com =
+        Mat3::Identity() * (0.4 * inertial.mass * radius * radius);
+    reading.warning = where + " <inertia> is all zero and it has no collision geometry; taken " +
+                      "as a ball of water of " + FormatNumber(inertial.mass) + " kg";
+  } else if (all_zero) {
     // The geometry's tensor about the stated centre of mass, in the link
     // frame: the stated origin keeps the centre, the geometry the shape.
     in_inertial_frame.inertia_about_com =
@@ -139,13 +180,14 @@ Result<InertialReading> ReadInertial(const urdf::Link& link,
     link_from_com.rotation = Quat::Identity();
     reading.warning = where + " <inertia> is all zero; taken from its collision geometry for " +
                       FormatNumber(inertial.mass) + " kg";
-  } else if (BalanceInertia(&in_inertial_frame.inertia_about_com)) {
-    reading.warning = where + " <inertia> misses I1 + I2 >= I3 by less than " +
-                      FormatNumber(100.0 * kMaxTriangleDeficit) +
-                      " %; I1 and I2 raised until it holds";
+  } else if (const std::string repaired = RepairInertia(balance ? 1.0 : kMaxTriangleDeficit,
+                                                        &in_inertial_frame.inertia_about_com);
+             !repaired.empty()) {
+    reading.warning = where + " <inertia> " + repaired;
   }
   if (Status status = physics::ValidateMassProperties(in_inertial_frame); !status.ok()) {
-    return Result<InertialReading>::Error(where + ": invalid <inertial>: " + status.message());
+    return Result<InertialReading>::Error(where + ": invalid <inertial>: " + status.message() +
+                                          " (~balance_inertia repairs it)");
   }
   reading.in_link = physics::TransformMassProperties(in_inertial_frame, link_from_com);
   return reading;

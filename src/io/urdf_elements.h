@@ -82,19 +82,25 @@ struct InertialReading {
   std::string warning;              // empty, or what was inferred or adjusted
 };
 
-// The link's <inertial> in the link frame, checked: finite, symmetric and
-// positive definite, obeying the triangle inequality of principal moments.
-// Three habits of published descriptions are read as Bullet reads them:
+// The link's <inertial> in the link frame, checked: finite, mass >= 0 and
+// moments about the axes (ixx, iyy, izz) >= 0. Habits of published
+// descriptions are read as Bullet reads them, or repaired, each with a
+// warning:
 // - mass 0 is a massless link; its geometry gives it no mass either;
 // - mass > 0 with every <inertia> entry 0 takes the inertia of
 //   `geometry_in_link` (its collision geometry, uniform density) scaled to
-//   that mass, when there is geometry;
+//   that mass, or with no geometry a ball of water's of that mass;
 // - principal moments that miss I1 + I2 >= I3 by at most
 //   kMaxTriangleDeficit of I3 (rounding in CAD exports) have I1 and I2
-//   scaled up until it holds.
+//   scaled up until it holds;
+// - with `balance`, any tensor that is not positive definite or misses
+//   I1 + I2 >= I3 (PR2's, TIAGo's, ANYmal's) keeps its principal axes, its
+//   smaller moments raised to 1e-3 of the largest and then until
+//   I1 + I2 = I3; without, it is refused.
 inline constexpr double kMaxTriangleDeficit = 0.1;
 physics::Result<InertialReading> ReadInertial(const urdf::Link& link,
-                                              const physics::MassProperties& geometry_in_link);
+                                              const physics::MassProperties& geometry_in_link,
+                                              bool balance);
 
 }  // namespace rigid_body_sim::io
 

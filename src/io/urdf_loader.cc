@@ -384,7 +384,8 @@ class ModelBuilder {
     // mass properties for overlapping geometry states its <inertial>.
     const MassProperties from_geometry = physics::CombineMassProperties(geometry_parts_in_link);
     if (link.inertial != nullptr) {
-      Result<InertialReading> inertial = ReadInertial(link, from_geometry);
+      Result<InertialReading> inertial =
+          ReadInertial(link, from_geometry, options_.balance_inertia);
       if (!inertial.ok()) return inertial.status();
       if (!inertial->warning.empty()) loaded->warnings.push_back(inertial->warning);
       loaded->links[link_index].mass = inertial->in_link.mass;

@@ -362,6 +362,7 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"default_friction", &options->defaults.friction},
       {"default_restitution", &options->defaults.restitution},
       {"default_density", &options->default_density},
+      {"balance_inertia", &options->balance_inertia},
       {"max_hull_vertices", &options->max_hull_vertices},
       {"contact_margin", &world.contact_margin},
       {"contact_reuse_distance", &world.contact_reuse_distance},

@@ -45,6 +45,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       paused_(options_.paused),
       live_(LiveSettingsOf(options_)) {
   load_options_.default_density = options_.default_density;
+  load_options_.balance_inertia = options_.balance_inertia;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
   load_options_.max_links = options_.max_links_per_model;
   load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);

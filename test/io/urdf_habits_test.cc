@@ -1,9 +1,11 @@
 // Habits of published robot descriptions that Bullet and Gazebo accept,
 // read the same way here: massless links and models, an all-zero inertia,
-// a triangle inequality missed by rounding, joint limits that exclude 0,
+// tensors that miss the triangle inequality or positive definiteness,
+// joint limits that exclude 0,
 // a movable joint to 'world', and Gazebo's older <mu1 value="..."/>.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -69,9 +71,10 @@ TEST(UrdfHabitsTest, AllZeroInertiaComesFromTheGeometryForTheStatedMass) {
 }
 
 // Moments that miss I1 + I2 >= I3 by 0.8 % (a published two-joint robot's
-// link) are raised by one factor until I1 + I2 = I3; by 33 % they are
-// refused.
-TEST(UrdfHabitsTest, TriangleInequalityMissedByRoundingIsBalanced) {
+// link) are raised by one factor until I1 + I2 = I3. By a third they are
+// refused, as MuJoCo and Drake refuse them, unless balance_inertia asks for
+// the same repair (PR2's sensor_mount_link misses by a factor 5).
+TEST(UrdfHabitsTest, TriangleInequalityMissedIsBalancedOrRefused) {
   const double i1 = 0.000913205574, i2 = 0.167168924, i3 = 0.169417871;
   const Result<LoadedModel> model = LoadUrdfString(
       "<robot name='r'>" +
@@ -86,10 +89,70 @@ TEST(UrdfHabitsTest, TriangleInequalityMissedByRoundingIsBalanced) {
   EXPECT_NEAR(inertia(2, 2), i3, 1e-15);
   EXPECT_NEAR(inertia(0, 0) + inertia(1, 1), inertia(2, 2), 1e-15);
 
-  const Result<LoadedModel> refused = LoadUrdfString(
-      "<robot name='r'>" + Link("body", Inertial("1", "ixx='1' iyy='1' izz='3'")) + "</robot>");
+  const std::string far = "<robot name='r'>" +
+                          Link("body", Inertial("1", "ixx='1' iyy='1' izz='3'") + Box("1 1 1")) +
+                          "</robot>";
+  const Result<LoadedModel> refused = LoadUrdfString(far);
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.message().find("triangle inequality"), std::string::npos);
+  EXPECT_NE(refused.message().find("~balance_inertia"), std::string::npos);
+  UrdfLoadOptions balance;
+  balance.balance_inertia = true;
+  const Result<LoadedModel> balanced = LoadUrdfString(far, balance);
+  ASSERT_TRUE(balanced.ok()) << balanced.message();
+  EXPECT_NEAR(balanced->mass_properties.inertia_about_com(0, 0), 1.5, 1e-12);
+  EXPECT_NEAR(balanced->mass_properties.inertia_about_com(1, 1), 1.5, 1e-12);
+  EXPECT_NEAR(balanced->mass_properties.inertia_about_com(2, 2), 3.0, 1e-12);
+  ASSERT_EQ(balanced->warnings.size(), 1u);
+  EXPECT_NE(balanced->warnings[0].find("misses I1 + I2 >= I3"), std::string::npos);
+}
+
+// A sensor frame's tensor of 1e-6 in every entry (TIAGo's antennas) has
+// principal moments 0, 0 and 3e-6 about n = (1, 1, 1)/sqrt(3): refused by
+// default; with balance_inertia the two zero moments are raised to 1e-3 of
+// the largest, then to 1.5e-6 each (I1 + I2 = I3), so the tensor is
+// 1.5e-6 (1 + n n^T): 2e-6 on the diagonal and 0.5e-6 off it. An all-zero
+// tensor without geometry is a ball of water's, 2/5 m r^2 with
+// 4/3 pi r^3 1000 kg/m^3 = m; a negative moment is refused by name.
+TEST(UrdfHabitsTest, TensorsNotPositiveDefiniteAreRefusedOrRepaired) {
+  const std::string singular_urdf =
+      "<robot name='r'><link name='body'><inertial><mass value='0.1'/><inertia ixx='1e-6' "
+      "ixy='1e-6' ixz='1e-6' iyy='1e-6' iyz='1e-6' izz='1e-6'/></inertial>" +
+      Box("0.1 0.1 0.1") + "</link></robot>";
+  const Result<LoadedModel> refused = LoadUrdfString(singular_urdf);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("link 'body': invalid <inertial>"), std::string::npos)
+      << refused.message();
+  UrdfLoadOptions balance;
+  balance.balance_inertia = true;
+  const Result<LoadedModel> singular = LoadUrdfString(singular_urdf, balance);
+  ASSERT_TRUE(singular.ok()) << singular.message();
+  const physics::Mat3& inertia = singular->mass_properties.inertia_about_com;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(inertia(r, c), r == c ? 2e-6 : 0.5e-6, 1e-15);
+  }
+  ASSERT_EQ(singular->warnings.size(), 1u);
+  EXPECT_NE(singular->warnings[0].find("is not positive definite"), std::string::npos);
+
+  const std::string arm = Link("base", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1"));
+  const std::string joint =
+      "<joint name='weld' type='fixed'><parent link='base'/><child link='sensor'/></joint>";
+  const Result<LoadedModel> ball =
+      LoadUrdfString("<robot name='r'>" + arm + Link("sensor", Inertial("0.5", kZeroMoments)) +
+                     joint + "</robot>");
+  ASSERT_TRUE(ball.ok()) << ball.message();
+  const double radius = std::cbrt(3.0 * 0.5 / (4.0 * physics::kPi * 1000.0));
+  // The box's 1 kg m^2 about each axis plus the ball's, both at the origin.
+  EXPECT_NEAR(ball->mass_properties.inertia_about_com(2, 2), 1.0 + 0.4 * 0.5 * radius * radius,
+              1e-12);
+
+  const Result<LoadedModel> negative = LoadUrdfString(
+      "<robot name='r'>" + Link("body", Inertial("1", "ixx='-1' iyy='1' izz='1'") + Box("1 1 1")) +
+      "</robot>");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_NE(negative.message().find("link 'body': invalid <inertial>: ixx -1 is negative"),
+            std::string::npos)
+      << negative.message();
 }
 
 // An elbow limited to [-1.5, -0.03] rad starts at -0.03 when no position is

@@ -56,6 +56,11 @@ struct UrdfLoadOptions {
   // kg/m^3: density of links without <inertial>, whose mass properties are
   // computed from their collision geometry.
   double default_density = 1000.0;
+  // An <inertia> that is not positive definite or whose principal moments
+  // miss I1 + I2 >= I3 by more than 10 % is refused by default (as MuJoCo
+  // and Drake refuse it); when true it is repaired with a warning, keeping
+  // its principal axes (as Gazebo and Bullet load it; see ReadInertial).
+  bool balance_inertia = false;
   HullOptions hull;      // for <mesh> collisions
   int max_links = 1000;  // count, >= 1: a model with more <link>s is refused
   // Bytes; a URDF or mesh file larger than this, or not a regular file

@@ -51,6 +51,9 @@ struct NodeOptions {
   // URDF loading.
   double default_density = 1000.0;
   int max_hull_vertices = 256;
+  // ~balance_inertia (false): repair, with a warning, an <inertia> that is
+  // not positive definite or misses I1 + I2 >= I3, instead of refusing it.
+  bool balance_inertia = false;
   double status_period = 5.0;  // ~status_period: s of real time between INFO status lines, > 0
   // ~contact_force_scale: m of contact-marker arrow per N of normal force, > 0
   double contact_force_scale = 0.02;
