@@ -100,14 +100,18 @@ namespace {
 // keeping the principal axes, each moment is raised to at least
 // kMinMomentRatio of the largest, then I1 and I2 by one factor until
 // I1 + I2 = I3, a flat plate's moments, the nearest a rigid body can have.
-// Only a tensor that misses I1 + I2 >= I3 by at most `max_deficit` of I3
-// is repaired. Returns what was changed, or an empty string when nothing
-// was (a valid tensor, or one left for the validation to refuse).
+// Unless `max_deficit` is 1 or more, only a positive definite tensor that
+// misses I1 + I2 >= I3 by at most `max_deficit` of I3 is repaired. Returns what was changed, or an
+// empty string when nothing was (a valid tensor, or one left for the validation to refuse).
 std::string RepairInertia(double max_deficit, Mat3* inertia) {
   constexpr double kMinMomentRatio = 1e-3;
   const physics::PrincipalAxes axes = physics::ComputePrincipalAxes(*inertia);
   const Vec3 before = axes.principal_moments;
-  if (before[0] + before[1] < (1.0 - max_deficit) * before[2]) return "";
+  const bool balance_all = max_deficit >= 1.0;
+  if (!balance_all &&
+      (!(before[0] > 0.0) || before[0] + before[1] < (1.0 - max_deficit) * before[2])) {
+    return "";
+  }
   Vec3 moments = before;
   const double floor = kMinMomentRatio * moments[2];
   for (int k = 0; k < 2; ++k) moments[k] = std::max(moments[k], floor);

@@ -133,6 +133,21 @@ TEST(UrdfHabitsTest, TensorsNotPositiveDefiniteAreRefusedOrRepaired) {
   }
   ASSERT_EQ(singular->warnings.size(), 1u);
   EXPECT_NE(singular->warnings[0].find("is not positive definite"), std::string::npos);
+  // A negative principal moment: -3.5e-8 beside 3.5e-8 and 9.1e-8 kg m^2
+  // (TIAGo's antenna); balanced, the moments obey I1 + I2 >= I3.
+  const std::string negative_moment =
+      "<robot name='r'><link name='body'><inertial><mass value='0.1'/><inertia "
+      "ixx='2.371e-8' ixy='6.119e-8' ixz='1.179e-8' iyy='2.833e-8' iyz='7.74e-9' "
+      "izz='3.849e-8'/></inertial>" +
+      Box("0.1 0.1 0.1") + "</link></robot>";
+  EXPECT_FALSE(LoadUrdfString(negative_moment).ok());
+  const Result<LoadedModel> raised = LoadUrdfString(negative_moment, balance);
+  ASSERT_TRUE(raised.ok()) << raised.message();
+  const physics::PrincipalAxes axes =
+      physics::ComputePrincipalAxes(raised->mass_properties.inertia_about_com);
+  EXPECT_GT(axes.principal_moments[0], 0.0);
+  EXPECT_NEAR(axes.principal_moments[0] + axes.principal_moments[1], axes.principal_moments[2],
+              1e-20);
 
   const std::string arm = Link("base", Inertial("1", "ixx='1' iyy='1' izz='1'") + Box("1 1 1"));
   const std::string joint =
