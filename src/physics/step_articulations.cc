@@ -189,11 +189,12 @@ void WorldImpl::SolveArticulations(double dt) {
     const int candidate = articulation_solver_.AddArticulation(u_free, mass);
     AddArticulationRows(i, candidate, u_free, dt);
     const bool has_rows = articulation_solver_.rows().size() > rows_before;
-    const bool stiff_damping = DampingIsStiff(model, dynamics.mass, dt);
     for (ArticulationJoint& joint : model.joints) {
       joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
     }
-    if (has_rows || touched[i] || stiff_damping) {
+    // The damping test inverts M, so it runs only when nothing else has
+    // chosen the velocity-level step.
+    if (has_rows || touched[i] || DampingIsStiff(model, dynamics.mass, dt)) {
       slot[i] = candidate;
     } else {
       entry.next = StepFreeMotion(model, entry.state, settings_.gravity, efforts, dt);
