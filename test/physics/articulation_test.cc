@@ -304,45 +304,8 @@ TEST(ArticulationTest, ServoHoldsWithinTauOverKAndMotorKeepsItsSpeed) {
   EXPECT_NEAR(world.GetJointStates(id)[0].velocity, 0.5, 5e-3);
 }
 
-// A floating two-link articulation (a box with a flap) dropped on the
-// ground comes to rest on it at the box's half height, and a refused
-// definition leaves the world unchanged.
-TEST(ArticulationTest, FloatingArticulationRestsOnTheGround) {
-  World world = MakeWorld();
-  AddGround(&world, MakeMaterial(0.8, 0.0));
-  ArticulationDef def;
-  def.world_from_base = Translation(0, 0, 0.5);
-  LinkDef body;
-  body.mass_properties = BoxMassProperties(1000.0, Vec3(0.2, 0.2, 0.2));
-  ShapeDef box;
-  box.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3(0.2, 0.2, 0.2)));
-  box.material = MakeMaterial(0.8, 0.0);
-  body.shapes.push_back(box);
-  LinkDef flap;
-  flap.mass_properties = BoxMassProperties(1000.0, Vec3(0.05, 0.05, 0.05));
-  flap.mass_properties.center_of_mass = Vec3(0, 0, 0.05);
-  JointDef hinge;
-  hinge.name = "flap";
-  hinge.type = JointType::kRevolute;
-  hinge.parent_from_joint.translation = Vec3(0, 0, 0.1);
-  hinge.axis = Vec3::UnitY();
-  hinge.lower = -0.1;
-  hinge.upper = 0.1;
-  def.links = {body, flap};
-  def.joints = {hinge};
-  const std::size_t bodies_before = world.BodyCount();
-  ArticulationDef bad = def;
-  bad.joints[0].position = 0.5;  // outside [-0.1, 0.1]
-  EXPECT_FALSE(world.CreateArticulation(bad).ok());
-  EXPECT_EQ(world.BodyCount(), bodies_before);
-  const ArticulationId id = world.CreateArticulation(def).value();
-  for (int step = 0; step < 2 * 240; ++step) world.Step();
-  const Pose base = world.GetPose(world.ArticulationLinks(id)[0]);
-  EXPECT_NEAR(base.translation.z(), 0.1, 1e-3);
-  EXPECT_LT(world.GetLinearVelocity(world.ArticulationLinks(id)[0]).norm(), 1e-2);
-}
-
-// The box and flap of the test above, its base at `base_z`.
+// A 0.2 m box with a 5 cm flap on a continuous hinge on its top, its base
+// at `base_z`.
 ArticulationDef BoxWithFlap(double base_z) {
   ArticulationDef def;
   def.world_from_base = Translation(0, 0, base_z);
@@ -363,6 +326,28 @@ ArticulationDef BoxWithFlap(double base_z) {
   def.links = {body, flap};
   def.joints = {hinge};
   return def;
+}
+
+// A floating two-link articulation (a box with a flap) dropped on the
+// ground comes to rest on it at the box's half height, and a refused
+// definition leaves the world unchanged.
+TEST(ArticulationTest, FloatingArticulationRestsOnTheGround) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(0.8, 0.0));
+  ArticulationDef def = BoxWithFlap(0.5);
+  def.joints[0].type = JointType::kRevolute;
+  def.joints[0].lower = -0.1;
+  def.joints[0].upper = 0.1;
+  const std::size_t bodies_before = world.BodyCount();
+  ArticulationDef bad = def;
+  bad.joints[0].position = 0.5;  // outside [-0.1, 0.1]
+  EXPECT_FALSE(world.CreateArticulation(bad).ok());
+  EXPECT_EQ(world.BodyCount(), bodies_before);
+  const ArticulationId id = world.CreateArticulation(def).value();
+  for (int step = 0; step < 2 * 240; ++step) world.Step();
+  const Pose base = world.GetPose(world.ArticulationLinks(id)[0]);
+  EXPECT_NEAR(base.translation.z(), 0.1, 1e-3);
+  EXPECT_LT(world.GetLinearVelocity(world.ArticulationLinks(id)[0]).norm(), 1e-2);
 }
 
 // Spawned 8 cm into the ground, the box is lifted out by the split
