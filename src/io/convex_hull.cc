@@ -75,22 +75,30 @@ void SortCounterClockwise(const std::vector<Vec3>& points, const Vec3& normal,
   for (size_t i = 0; i < by_angle.size(); ++i) (*face)[i] = by_angle[i].second;
 }
 
-// Runs reentrant qhull (Barber, Dobkin, Huhdanpaa 1996, "The Quickhull
-// Algorithm for Convex Hulls") on the points selected by `ids`, with the
-// qhull command line `options`. The default options pre-merge facets that are coplanar within
-// round-off ('C-0'), so flat regions come out as single non-simplicial facets. qh_new_qhull traps
-// qhull's internal errors with its own setjmp and returns an exit code; the
-// facet walk afterwards calls nothing that can raise an error.
-Result<RawHull> RunQhull(const std::vector<Vec3>& points, const std::vector<int>& ids,
-                         const char* options = "qhull") {
-  // Centring the coordinates keeps qhull's round-off small for meshes that
-  // are far from their origin.
+// The lower and upper corners of the bounding box of the points selected by
+// `ids` (at least one).
+std::pair<Vec3, Vec3> BoundsOf(const std::vector<Vec3>& points, const std::vector<int>& ids) {
   Vec3 low = points[ids.front()];
   Vec3 high = low;
   for (int id : ids) {
     low = low.cwiseMin(points[id]);
     high = high.cwiseMax(points[id]);
   }
+  return {low, high};
+}
+
+// Runs reentrant qhull (Barber, Dobkin, Huhdanpaa 1996, "The Quickhull
+// Algorithm for Convex Hulls") on the points selected by `ids`, with the
+// qhull command line `options`. The default options pre-merge facets that
+// are coplanar within round-off ('C-0'), so flat regions come out as single
+// non-simplicial facets. qh_new_qhull traps qhull's internal errors with
+// its own setjmp and returns an exit code; the facet walk afterwards calls
+// nothing that can raise an error.
+Result<RawHull> RunQhull(const std::vector<Vec3>& points, const std::vector<int>& ids,
+                         const char* options = "qhull") {
+  // Centring the coordinates keeps qhull's round-off small for meshes that
+  // are far from their origin.
+  const auto [low, high] = BoundsOf(points, ids);
   const Vec3 center = 0.5 * (low + high);
   std::vector<coordT> coordinates;
   coordinates.reserve(3 * ids.size());
@@ -351,12 +359,7 @@ Result<ConvexPolyhedron> HullOf(const std::vector<Vec3>& points, const std::vect
   if (!hull.ok()) return hull.status();
   Result<ConvexPolyhedron> polyhedron = ToPolyhedron(points, *hull);
   if (polyhedron.ok()) return polyhedron;
-  Vec3 low = points[ids.front()];
-  Vec3 high = low;
-  for (int id : ids) {
-    low = low.cwiseMin(points[id]);
-    high = high.cwiseMax(points[id]);
-  }
+  const auto [low, high] = BoundsOf(points, ids);
   const double diagonal = (high - low).norm();
   for (const double relative_radius : {1e-8, 1e-7, 1e-6}) {
     char options[64];
