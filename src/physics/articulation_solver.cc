@@ -163,17 +163,40 @@ int ArticulationSolver::Solve(int max_sweeps, double tolerance) {
         ++k;  // its pair was updated with it
         continue;
       }
-      if (row.inverse_mass == 0.0) continue;
-      const double velocity = RowVelocity(row);
-      double next =
-          row.impulse - row.inverse_mass * (velocity - row.target + row.softness * row.impulse);
-      next = row.kind == RowKind::kNormal ? std::max(next, 0.0)
-                                          : std::clamp(next, row.lower, row.upper);
-      const double change = next - row.impulse;
-      row.impulse = next;
-      if (change != 0.0) ApplyImpulse(row, change);
-      largest = std::max(largest, std::abs(change));
-      scale = std::max(scale, std::abs(next));
+      largest = std::max(largest, UpdateRow(&row));
+      scale = std::max(scale, std::abs(row.impulse));
+    }
+    if (largest <= tolerance * std::max(scale, 1e-12)) break;
+  }
+  return sweep;
+}
+
+// lambda <- proj(lambda - (v - target + gamma lambda) / (J M^-1 J^T + gamma)),
+// onto lambda >= 0 for a normal, [lower, upper] for a bounded row.
+double ArticulationSolver::UpdateRow(ConstraintRow* row) {
+  if (row->inverse_mass == 0.0) return 0.0;
+  const double velocity = RowVelocity(*row);
+  double next =
+      row->impulse - row->inverse_mass * (velocity - row->target + row->softness * row->impulse);
+  next = row->kind == RowKind::kNormal ? std::max(next, 0.0)
+                                       : std::clamp(next, row->lower, row->upper);
+  const double change = next - row->impulse;
+  row->impulse = next;
+  if (change != 0.0) ApplyImpulse(*row, change);
+  return std::abs(change);
+}
+
+int ArticulationSolver::SweepRows(const std::vector<std::size_t>& rows, int max_sweeps,
+                                  double tolerance) {
+  int sweep = 0;
+  while (sweep < max_sweeps) {
+    ++sweep;
+    double largest = 0.0;
+    double scale = 0.0;
+    for (const std::size_t k : rows) {
+      assert(rows_[k].kind != RowKind::kTangent);
+      largest = std::max(largest, UpdateRow(&rows_[k]));
+      scale = std::max(scale, std::abs(rows_[k].impulse));
     }
     if (largest <= tolerance * std::max(scale, 1e-12)) break;
   }

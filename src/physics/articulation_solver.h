@@ -62,6 +62,10 @@ struct ConstraintRow {
   double friction = 0.0;   // kTangent: mu
   double impulse = 0.0;    // lambda, warm start in, result out
   bool colliding = false;  // a contact point classified colliding
+  // kNormal of a contact point still apart that closes within the step
+  // faster than the collision threshold: -e v-, the v+ it leaves with once
+  // its row has stopped it (impulse > 0). 0: no bounce.
+  double bounce = 0.0;
   // A joint's own row (limit, servo, motor, friction): whose, and the sign
   // its impulse has as the joint's effort.
   int articulation = -1;
@@ -97,6 +101,9 @@ class ArticulationSolver {
   // Projected Gauss-Seidel until no impulse changes by more than
   // `tolerance` (relative to its size) or `max_sweeps`. Returns the sweeps.
   int Solve(int max_sweeps, double tolerance);
+  // Further sweeps over the given rows only (none a tangent), the other
+  // rows' impulses held; returns the sweeps.
+  int SweepRows(const std::vector<std::size_t>& rows, int max_sweeps, double tolerance);
   // v_k = J_k u with the current velocities.
   double RowVelocity(const ConstraintRow& row) const;
 
@@ -108,6 +115,9 @@ class ArticulationSolver {
   double SideVelocity(const RowSide& side) const;
   double SideResponse(const RowSide& side) const;  // J M^-1 J^T of the side
   void ApplyImpulse(const ConstraintRow& row, double impulse);
+  // One projected Gauss-Seidel update of a normal or bounded row; returns
+  // |change of its impulse|.
+  double UpdateRow(ConstraintRow* row);
   double UpdateFriction(std::size_t k);
 
   std::vector<ArticulationSlot> articulations_;

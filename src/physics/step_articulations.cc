@@ -209,6 +209,7 @@ void WorldImpl::SolveArticulations(double dt) {
     entry.next =
         Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
   }
+  BounceLinkContacts(slot);
   CorrectLinkPenetration(dt, slot);
   // A joint's effort: its command's, its rows' impulses over dt, less its
   // damping; shared with its mimics, each taking its multiplier's part.
@@ -261,10 +262,31 @@ void WorldImpl::SolveArticulations(double dt) {
 // restitution, v+ >= -e v-; one apart by s may close it within the step,
 // v+ >= -s / dt (so nothing passes through a link); one penetrating stops
 // sinking, v+ >= 0, and beyond the slop is pushed out by the split impulse
-// (CorrectLinkPenetration), which moves positions only.
+// (CorrectLinkPenetration), which moves positions only. A point is
+// classified by v- at the start of the step, before the forces act (Baraff
+// 1997, "Rigid Body Simulation II", section 8): a link resting on the
+// ground closes at g dt by the end of the free step, above the collision
+// threshold, and with e > 0 it would hop every step.
 void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
                                    const std::vector<ArticulationKinematics>& kinematics) {
   const SolverSettings& solver = settings_.solver;
+  // d . (velocity of the body's point at `point`) before this step's forces:
+  // a link's from the joint-space velocity the step starts with, a rigid
+  // body's from the momenta IntegrateForces started from.
+  auto start_velocity = [&](std::uint32_t index, const Vec3& direction, const Vec3& point) {
+    const Body& body = bodies_[index];
+    const Vec3 r = point - body.position;
+    if (body.articulation >= 0) {
+      const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
+      const Eigen::VectorXd& u = articulations_[body.articulation].state.u;
+      const Vec3 linear = jacobian.topRows<3>() * u;
+      const Vec3 angular = jacobian.bottomRows<3>() * u;
+      return direction.dot(linear + angular.cross(r));
+    }
+    if (body.is_static || !body.awake || body.disabled) return 0.0;
+    const Vec3 angular = body.inverse_inertia_world * body.start_angular_momentum;
+    return direction.dot(body.start_linear_velocity + angular.cross(r));
+  };
   link_pair_rows_.assign(link_pairs_.size(), -1);
   link_penetrations_.clear();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
@@ -305,7 +327,8 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
       normal_row.kind = RowKind::kNormal;
       normal_row.a = side(pair.body_a, normal, point.position_world);
       normal_row.b = side(pair.body_b, -normal, point.position_world);
-      const double approach = articulation_solver_.RowVelocity(normal_row);
+      const double approach = start_velocity(pair.body_a, normal, point.position_world) +
+                              start_velocity(pair.body_b, -normal, point.position_world);
       const double separation = point.separation;
       if (separation <= solver.contact_tolerance &&
           approach < -solver.collision_velocity_threshold) {
@@ -313,6 +336,9 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
         normal_row.colliding = true;
       } else if (separation > 0.0) {
         normal_row.target = -separation / dt;
+        if (approach < -solver.collision_velocity_threshold && approach * dt < -separation) {
+          normal_row.bounce = -restitution * approach;
+        }
       } else {
         normal_row.target = 0.0;
       }
@@ -334,6 +360,34 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
         articulation_solver_.AddRow(std::move(tangent_row));
       }
     }
+  }
+}
+
+// Restitution of the link contacts that close within the step. A link has
+// no time-of-impact search: a point still apart at the start of the step is
+// stopped where it touches by its row, v+ >= -s / dt, and the speed it came
+// with is gone by the next step, where it would bounce. So once the
+// positions are advanced, the rows of such points that took an impulse are
+// solved again, the others' impulses held, for v+ >= -e v-, the speed it
+// leaves with (the restitution pass of Catto, "Solver2D", 2024, after the
+// position update). The body ends the step at the contact, moving off at
+// e |v-|, up to one step late against the exact rise.
+void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation) {
+  std::vector<std::size_t>& bouncing = link_bouncing_rows_;
+  bouncing.clear();
+  std::vector<ConstraintRow>& rows = articulation_solver_.rows();
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    ConstraintRow& row = rows[k];
+    if (row.bounce <= 0.0 || row.impulse <= 0.0) continue;
+    row.target = row.bounce;
+    row.colliding = true;
+    bouncing.push_back(k);
+  }
+  if (bouncing.empty()) return;
+  articulation_solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    const int slot = slot_of_articulation[i];
+    if (slot >= 0) articulations_[i].next.u = articulation_solver_.articulations()[slot].u;
   }
 }
 

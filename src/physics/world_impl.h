@@ -178,6 +178,7 @@ class WorldImpl {
   void SolveArticulations(double dt);
   void AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free, double dt);
   void CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation);
+  void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
   void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
                           const std::vector<ArticulationKinematics>& kinematics);
   void ReportLinkContacts(double dt);
@@ -228,6 +229,7 @@ class WorldImpl {
   // the speed that removes position_correction of that depth in one step,
   // and the solver of their split impulse (CorrectLinkPenetration).
   std::vector<std::pair<int, double>> link_penetrations_;
+  std::vector<std::size_t> link_bouncing_rows_;  // scratch of BounceLinkContacts
   ArticulationSolver link_pseudo_solver_;
 };
 
