@@ -369,8 +369,8 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
 // with is gone by the next step, where it would bounce. So once the
 // positions are advanced, the rows of such points that took an impulse are
 // solved again, the others' impulses held, for v+ >= -e v-, the speed it
-// leaves with (the restitution pass of Catto, "Solver2D", 2024, after the
-// position update). The body ends the step at the contact, moving off at
+// leaves with (the restitution pass after the position update of Box2D
+// v3.0, Catto 2024, contact_solver.c). The body ends the step at the contact, moving off at
 // e |v-|, up to one step late against the exact rise.
 void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation) {
   std::vector<std::size_t>& bouncing = link_bouncing_rows_;
