@@ -230,15 +230,23 @@ void WorldImpl::SolveArticulations(double dt) {
       joint.effort = joint.def.mimic_multiplier * entry.model.joints[joint.def.mimic_joint].effort;
     }
   }
-  for (const ArticulationSolver::BodySlot& slot_body : articulation_solver_.bodies()) {
+  const std::vector<ArticulationSolver::BodySlot>& slots = articulation_solver_.bodies();
+  for (std::size_t index = 0; index < slots.size(); ++index) {
+    const ArticulationSolver::BodySlot& slot_body = slots[index];
     Body& body = bodies_[slot_body.body];
     if (body.inverse_mass == 0.0 || !body.awake || body.disabled || body.articulation >= 0)
       continue;
-    const Vec3 linear_change = slot_body.linear_velocity - body.linear_velocity;
+    // The velocities of the solve, before any restitution pass.
+    const ArticulationSolver::BodySlot& solved =
+        link_solved_bodies_.empty() ? slot_body : link_solved_bodies_[index];
     const Mat3 rotation = body.orientation.toRotationMatrix();
-    const Vec3 angular_momentum = rotation *
-                                  body.inverse_principal_moments.cwiseInverse().asDiagonal() *
-                                  (rotation.transpose() * slot_body.angular_velocity);
+    auto momentum = [&](const Vec3& angular_velocity) -> Vec3 {
+      return rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+             (rotation.transpose() * angular_velocity);
+    };
+    const Vec3 linear_change = solved.linear_velocity - body.linear_velocity;
+    const Vec3 solved_momentum = momentum(solved.angular_velocity);
+    const Vec3 angular_momentum = momentum(slot_body.angular_velocity);
     // A change that resting forces can make within the step (at most the
     // collision threshold beyond what gravity gives) is a force over it:
     // the trapezoidal drift keeps it exact, as kinetic friction on a
@@ -248,8 +256,13 @@ void WorldImpl::SolveArticulations(double dt) {
                            settings_.time_step * settings_.gravity.norm();
     if (linear_change.norm() > resting) {
       body.start_linear_velocity += linear_change;
-      body.start_angular_momentum += angular_momentum - body.angular_momentum;
+      body.start_angular_momentum += solved_momentum - body.angular_momentum;
     }
+    // A bounce of the restitution pass leaves the drift as the solve made it
+    // (to where the body touches, as a link's positions), changing only the
+    // velocity it ends the step with: dt/2 (v_start + v_end) is unchanged.
+    body.start_linear_velocity -= slot_body.linear_velocity - solved.linear_velocity;
+    body.start_angular_momentum -= angular_momentum - solved_momentum;
     body.linear_momentum = body.mass * slot_body.linear_velocity;
     body.angular_momentum = angular_momentum;
     body.UpdateDerived();
@@ -375,6 +388,7 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
 void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation) {
   std::vector<std::size_t>& bouncing = link_bouncing_rows_;
   bouncing.clear();
+  link_solved_bodies_.clear();
   std::vector<ConstraintRow>& rows = articulation_solver_.rows();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     ConstraintRow& row = rows[k];
@@ -384,6 +398,7 @@ void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation)
     bouncing.push_back(k);
   }
   if (bouncing.empty()) return;
+  link_solved_bodies_ = articulation_solver_.bodies();
   articulation_solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     const int slot = slot_of_articulation[i];

@@ -230,6 +230,9 @@ class WorldImpl {
   // and the solver of their split impulse (CorrectLinkPenetration).
   std::vector<std::pair<int, double>> link_penetrations_;
   std::vector<std::size_t> link_bouncing_rows_;  // scratch of BounceLinkContacts
+  // The rigid bodies' velocities of the link solve before its restitution
+  // pass, per body slot; empty when no point bounced this step.
+  std::vector<ArticulationSolver::BodySlot> link_solved_bodies_;
   ArticulationSolver link_pseudo_solver_;
 };
 
