@@ -1,6 +1,7 @@
 // Colliding contact: impulses with restitution (Baraff 1997,
 // "Rigid Body Simulation II", section 8, eqs. (8-7)-(8-18)).
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -18,6 +19,51 @@ using testing::KineticEnergy;
 using testing::MakeMaterial;
 using testing::SphereSpec;
 using testing::Translation;
+
+// A unit cube tipped 0.7 rad onto one bottom edge and released falls back
+// onto its face. Rotating about that edge it lands at
+// omega- = sqrt(2 g (h(0.7) - 1/2) / I_edge), h(phi) = (cos phi + sin phi) / 2
+// the height of its centre, I_edge = 2/3 kg m^2. The impact of the far edge
+// (e = 0, no slip with mu = 10) keeps the angular momentum about that edge:
+// omega+ = (1 - 3/2 sin^2 alpha) omega- = omega- / 4 for a cube, alpha = 45
+// degrees (Housner 1963, "The behavior of inverted pendulum structures
+// during earthquakes", Bull. Seismol. Soc. Am. 53(2), eq. (2)). After the
+// impact the cube turns about the new edge, slowed by gravity at
+// alpha_g = g (1/2) / I_edge for the rest of the step, so at the end of the
+// step omega lies in [omega- / 4 - alpha_g dt, omega- / 4].
+TEST(CollisionTest, ToppledCubeKeepsAQuarterOfItsSpin) {
+  constexpr double kTilt = 0.7;  // rad, below 45 degrees: it falls back
+  const double g = 9.81;
+  WorldSettings settings;
+  settings.sleep.enabled = false;
+  World world(settings);
+  AddGround(&world, MakeMaterial(10.0, 0.0));
+  BoxSpec spec;
+  spec.material = MakeMaterial(10.0, 0.0);
+  const Quat tilt(Eigen::AngleAxisd(-kTilt, Vec3::UnitY()));
+  // The edge x = -1/2, z = -1/2 of the box at the origin of the ground.
+  spec.world_from_body = Pose{-(tilt * Vec3(-0.5, 0.0, -0.5)), tilt};
+  const BodyId cube = AddBox(&world, spec);
+  const double drop = 0.5 * (std::cos(kTilt) + std::sin(kTilt)) - 0.5;
+  const double inertia = 2.0 / 3.0;
+  const double before = std::sqrt(2.0 * g * drop / inertia);
+  const double slowing = g * 0.5 / inertia * settings.time_step;
+  double previous = 0.0;
+  double after = -1.0;
+  for (int step = 0; step < 480 && after < 0.0; ++step) {
+    world.Step();
+    const double spin = world.GetAngularVelocity(cube).y();
+    if (spin < 0.5 * previous) after = spin;
+    previous = spin;
+  }
+  std::printf("omega- %.4f rad/s, omega+ %.4f rad/s (%.4f of omega-)\n", before, after,
+              after / before);
+  EXPECT_LE(after, 0.25 * before + 1e-3);
+  EXPECT_GE(after, 0.25 * before - slowing - 1e-3);
+  // The motion is symmetric about the xz plane: no turn about x beyond what
+  // the sweeps' stop at velocity_tolerance (1e-6 m/s at 0.5 m) leaves.
+  EXPECT_NEAR(world.GetAngularVelocity(cube).x(), 0.0, 1e-5);
+}
 
 // A ball dropped from h rises e^2 h after its first bounce and e^(2n) h after
 // its n-th, measured from where it struck. Flight between bounces conserves
