@@ -16,13 +16,16 @@
 //                      [--hull-bench PATH]
 //                      [--velocity-iterations N] [--time-to-sleep S]
 //                      [--velocity-tolerance V] [--interleave-independent-runs 0|1]
+//                      [--hill-amplitude A]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
 //   their number of runs. --velocity-iterations, --time-to-sleep (s),
 //   --velocity-tolerance (m/s) and --interleave-independent-runs run our
 //   engine with those solver and sleep settings instead of the defaults, to
 //   measure what a setting costs or buys; the header says so
-//   (--time-to-sleep also reaches bullet_oursleep).
+//   (--time-to-sleep also reaches bullet_oursleep). --hill-amplitude A (m,
+//   [0, 2], default 0.5) sets the height of terrain_100's hills, to measure
+//   how the time to rest grows with their slope.
 
 #include <algorithm>
 #include <cmath>
@@ -52,6 +55,7 @@ struct Options {
   double scale = 1.0;
   std::vector<std::string> only;
   std::string hull_bench;
+  double hill_amplitude = 0.5;  // m, terrain_100's hills
   OurSettingsOverrides overrides;
   std::string error;  // set when an option's value is refused
 };
@@ -99,6 +103,14 @@ Options ParseOptions(int argc, char** argv) {
       } else {
         options.overrides.velocity_tolerance = tolerance;
       }
+    } else if (key == "--hill-amplitude") {
+      char* end = nullptr;
+      const double amplitude = std::strtod(value.c_str(), &end);
+      if (end == value.c_str() || *end != '\0' || !(amplitude >= 0.0 && amplitude <= 2.0)) {
+        options.error = "--hill-amplitude wants a height in m in [0, 2], got " + value;
+      } else {
+        options.hill_amplitude = amplitude;
+      }
     } else if (key == "--interleave-independent-runs") {
       if (value != "0" && value != "1") {
         options.error = "--interleave-independent-runs wants 0 or 1, got " + value;
@@ -129,7 +141,7 @@ std::vector<Scene> SelectScenes(const Options& options) {
       MakeIncline(35.0),
       MakeChain(30, 10.0),
       MakeArmPush(100, 10.0),
-      MakeTerrain(100, 100000, 10.0),
+      MakeTerrain(100, 100000, 10.0, options.hill_amplitude),
       MakeFlatTerrain(100, 10.0),
   };
   if (!options.only.empty()) {
@@ -166,6 +178,9 @@ void PrintHeader(const Options& options, double window_seconds) {
   if (overrides.interleave_independent_runs) {
     std::printf("ours: interleave_independent_runs = %s\n",
                 *overrides.interleave_independent_runs ? "true" : "false");
+  }
+  if (options.hill_amplitude != 0.5) {
+    std::printf("terrain_100: hills of %g m instead of 0.5 m\n", options.hill_amplitude);
   }
   std::printf(
       "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "

@@ -270,8 +270,8 @@ Scene DropBoxes(int count, const Hills& hills, double seconds) {
 
 }  // namespace
 
-Scene MakeTerrain(int count, int triangles, double seconds) {
-  Scene scene = DropBoxes(count, Hills{0.5, 3.0}, seconds);
+Scene MakeTerrain(int count, int triangles, double seconds, double amplitude) {
+  Scene scene = DropBoxes(count, Hills{amplitude, 3.0}, seconds);
   scene.name = "terrain_" + std::to_string(count);
   const int cells = static_cast<int>(std::ceil(std::sqrt(0.5 * triangles)));
   const double cell = kTerrainSize / cells;

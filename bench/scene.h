@@ -135,11 +135,11 @@ Scene MakeChain(int links, double seconds);
 Scene MakeArmPush(int boxes, double seconds);
 
 // terrain_N: N unit boxes (1 kg, mu 0.5) dropped from 1 m above rolling
-// hills (amplitude 0.5 m, wavelength 3 m) made of `triangles` (rounded up
+// hills (amplitude 0.5 m unless given, wavelength 3 m) made of `triangles` (rounded up
 // to a square grid) over 40 x 40 m, in a square grid 3 m apart, each yawed
 // 0.3 rad more than the last. terrain_flat_N: the same drop onto the flat
 // half-space, the reference for the terrain's cost.
-Scene MakeTerrain(int count, int triangles, double seconds);
+Scene MakeTerrain(int count, int triangles, double seconds, double amplitude = 0.5);
 Scene MakeFlatTerrain(int count, double seconds);
 
 }  // namespace rigid_body_sim::bench
