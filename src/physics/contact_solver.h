@@ -204,6 +204,10 @@ class ContactSolver {
   // Returns whether it finished any island, which it then marks unconverged.
   bool FinishIslandsExactly();
   void ComputeMasses();
+  // Applies a collision round's restitution impulses, scaled so that they
+  // add no kinetic energy; returns the scale (collision_impulses.cc).
+  double ApplyRestitution(const std::vector<std::pair<int, int>>& active,
+                          const std::vector<double>& normal, bool last_round, double energy_before);
   bool SolveCompressionExactly(const std::vector<std::pair<int, int>>& active,
                                std::vector<double>* normal);
   // One PGS pass over the rows of the given points; returns the largest
@@ -221,6 +225,8 @@ class ContactSolver {
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
   std::vector<RestingRow> rows_;
+  // The bodies of the current collision round's points, each once.
+  std::vector<std::uint32_t> collision_bodies_;
   TaskPool* pool_ = nullptr;
   // One schedule per group of islands, each swept by one thread; a single
   // group (one thread, or one island) is the reference order.
