@@ -22,6 +22,15 @@ using testing::MakeMaterial;
 using testing::SphereSpec;
 using testing::Translation;
 
+// A world whose bodies never sleep, on the ground z <= 0 of `ground`.
+World WorldWithoutSleepOnGround(const Material& ground) {
+  WorldSettings settings;
+  settings.sleep.enabled = false;
+  World world(settings);
+  AddGround(&world, ground);
+  return world;
+}
+
 // A unit cube tipped 0.7 rad onto one bottom edge and released falls back
 // onto its face. Rotating about that edge it lands at
 // omega- = sqrt(2 g (h(0.7) - 1/2) / I_edge), h(phi) = (cos phi + sin phi) / 2
@@ -36,10 +45,7 @@ using testing::Translation;
 TEST(CollisionTest, ToppledCubeKeepsAQuarterOfItsSpin) {
   constexpr double kTilt = 0.7;  // rad, below 45 degrees: it falls back
   const double g = 9.81;
-  WorldSettings settings;
-  settings.sleep.enabled = false;
-  World world(settings);
-  AddGround(&world, MakeMaterial(10.0, 0.0));
+  World world = WorldWithoutSleepOnGround(MakeMaterial(10.0, 0.0));
   BoxSpec spec;
   spec.material = MakeMaterial(10.0, 0.0);
   const Quat tilt(Eigen::AngleAxisd(-kTilt, Vec3::UnitY()));
@@ -49,7 +55,7 @@ TEST(CollisionTest, ToppledCubeKeepsAQuarterOfItsSpin) {
   const double drop = 0.5 * (std::cos(kTilt) + std::sin(kTilt)) - 0.5;
   const double inertia = 2.0 / 3.0;
   const double before = std::sqrt(2.0 * g * drop / inertia);
-  const double slowing = g * 0.5 / inertia * settings.time_step;
+  const double slowing = g * 0.5 / inertia * world.settings().time_step;
   double previous = 0.0;
   double after = -1.0;
   for (int step = 0; step < 480 && after < 0.0; ++step) {
@@ -79,10 +85,7 @@ TEST(CollisionTest, ToppledCubeKeepsAQuarterOfItsSpin) {
 TEST(CollisionTest, EccentricFrictionalImpactAddsNoEnergy) {
   constexpr double kInertia = 0.05;  // kg m^2, about every axis
   const double g = 9.81;
-  WorldSettings settings;
-  settings.sleep.enabled = false;
-  World world(settings);
-  AddGround(&world, MakeMaterial(0.5, 1.0));
+  World world = WorldWithoutSleepOnGround(MakeMaterial(0.5, 1.0));
   BodyDef def;
   def.world_from_body = Pose{Vec3(0.0, 0.0, 1.0), Quat(Eigen::AngleAxisd(0.3, Vec3::UnitY()))};
   def.mass_properties.mass = 1.0;
