@@ -243,14 +243,14 @@ void ContactSolver::ResolveCollisions() {
 // Appl. Mech. 58(4), for slip that halts or reverses; Glocker 2013,
 // "Energetic consistency conditions for standard impacts, Part II",
 // Multibody Syst. Dyn. 32, for Poisson's law at several frictional
-// contacts). A rod
-// of 1 kg with I = 0.05 kg m^2 striking 1 m from its centre with e = 1 and
-// mu = 0.5 left with four times the energy it came with. So a round applies
-// only as much of its restitution impulses, s e j_c with s in [0, 1], as
-// leaves the kinetic energy of its bodies at most what it was before the
-// compression: applying s R to velocities u changes the energy by
-// b s + q s^2, b = sum_k R_k . u_k (zero where the compression left
-// v_r = 0) and q = 1/2 R.A R, measured by applying R once. Returns s.
+// contacts). A body of 1 kg with I = 0.05 kg m^2 striking 1 m from its
+// centre with e = 1 and mu = 0.5 left with four times the energy it came
+// with. So a round applies only as much of its restitution impulses,
+// s e j_c with s in [0, 1], as leaves the kinetic energy of its bodies at
+// most what it was before the compression: applying s R to velocities u
+// changes the energy by b s + q s^2, b = sum_k R_k . u_k (zero where the
+// compression left v_r = 0) and q = 1/2 R.A R, measured by applying R once.
+// Returns s.
 double ContactSolver::ApplyRestitution(const std::vector<std::pair<int, int>>& active,
                                        const std::vector<double>& normal, bool last_round,
                                        double energy_before) {

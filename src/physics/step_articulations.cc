@@ -383,8 +383,9 @@ void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_ar
 // positions are advanced, the rows of such points that took an impulse are
 // solved again, the others' impulses held, for v+ >= -e v-, the speed it
 // leaves with (the restitution pass after the position update of Box2D
-// v3.0, Catto 2024, contact_solver.c). The body ends the step at the contact, moving off at
-// e |v-|, up to one step late against the exact rise.
+// v3.0, Catto 2024, contact_solver.c). The body ends the step at the
+// contact, moving off at e |v-|, up to one step late against the exact
+// rise.
 void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation) {
   std::vector<std::size_t>& bouncing = link_bouncing_rows_;
   bouncing.clear();
