@@ -32,6 +32,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,6 +60,14 @@ struct Options {
   OurSettingsOverrides overrides;
   std::string error;  // set when an option's value is refused
 };
+
+// A finite number that is the whole of `text`, or nothing.
+std::optional<double> ParseNumber(const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
 
 Options ParseOptions(int argc, char** argv) {
   Options options;
@@ -88,28 +97,25 @@ Options ParseOptions(int argc, char** argv) {
         options.overrides.velocity_iterations = static_cast<int>(iterations);
       }
     } else if (key == "--time-to-sleep") {
-      char* end = nullptr;
-      const double seconds = std::strtod(value.c_str(), &end);
-      if (*end != '\0' || !(seconds > 0.0) || !std::isfinite(seconds)) {
+      const std::optional<double> seconds = ParseNumber(value);
+      if (!seconds || !(*seconds > 0.0)) {
         options.error = "--time-to-sleep wants a time in s, > 0, got " + value;
       } else {
-        options.overrides.time_to_sleep = seconds;
+        options.overrides.time_to_sleep = *seconds;
       }
     } else if (key == "--velocity-tolerance") {
-      char* end = nullptr;
-      const double tolerance = std::strtod(value.c_str(), &end);
-      if (*end != '\0' || !(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+      const std::optional<double> tolerance = ParseNumber(value);
+      if (!tolerance || !(*tolerance >= 0.0)) {
         options.error = "--velocity-tolerance wants a speed in m/s, >= 0, got " + value;
       } else {
-        options.overrides.velocity_tolerance = tolerance;
+        options.overrides.velocity_tolerance = *tolerance;
       }
     } else if (key == "--hill-amplitude") {
-      char* end = nullptr;
-      const double amplitude = std::strtod(value.c_str(), &end);
-      if (end == value.c_str() || *end != '\0' || !(amplitude >= 0.0 && amplitude <= 2.0)) {
+      const std::optional<double> amplitude = ParseNumber(value);
+      if (!amplitude || !(*amplitude >= 0.0 && *amplitude <= 2.0)) {
         options.error = "--hill-amplitude wants a height in m in [0, 2], got " + value;
       } else {
-        options.hill_amplitude = amplitude;
+        options.hill_amplitude = *amplitude;
       }
     } else if (key == "--interleave-independent-runs") {
       if (value != "0" && value != "1") {
