@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "physics/contact_manifold.h"
+#include "physics/resting_batches.h"
 #include "physics/task_pool.h"
 #include "physics/union_find.h"
 #include "rigid_body_sim/physics/body.h"
@@ -198,6 +199,10 @@ class ContactSolver {
   template <bool kPseudo>
   void SweepSchedule(const std::vector<SweepTask>& schedule);
   void SweepUntilConverged();
+  // With batch_independent_runs, copies the rows' impulses from the batches
+  // to rows_, or back.
+  void StoreBatchStates();
+  void LoadBatchStates();
   // SweepUntilConverged for one group's islands; returns its sweeps and adds
   // its row updates to *row_updates.
   int SweepGroupUntilConverged(std::size_t group, std::size_t* row_updates);
@@ -231,6 +236,9 @@ class ContactSolver {
   // One schedule per group of islands, each swept by one thread; a single
   // group (one thread, or one island) is the reference order.
   std::vector<std::vector<SweepTask>> schedules_;
+  // Per group, its schedule's runs in batches of independent runs, swept
+  // lane by lane (batch_independent_runs).
+  std::vector<RestingBatches> batches_;
   std::vector<std::uint32_t> island_group_;  // per island, its group
   // Per group, the tasks of its schedule with a row penetrating beyond the
   // slop: the only ones the split impulse's sweeps change anything in.

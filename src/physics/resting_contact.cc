@@ -35,6 +35,12 @@ void ContactSolver::SolveRestingContacts() {
   FindIslands();
   GroupIslands();
   ScheduleRuns();
+  if (settings_.batch_independent_runs) {
+    batches_.resize(schedules_.size());
+    RunGroups(pool_, schedules_.size(), [&](std::size_t group) {
+      BuildRestingBatches(schedules_[group], rows_, row_island_, bodies_.size(), &batches_[group]);
+    });
+  }
   for (const RestingRow& row : rows_) {
     ApplyRowImpulse(row, Vec3(row.normal_impulse, row.tangent_impulse[0], row.tangent_impulse[1]),
                     &bodies_);
@@ -43,9 +49,14 @@ void ContactSolver::SolveRestingContacts() {
   velocity_sweeps_ = 0;
   velocity_row_updates_ = 0;
   SweepUntilConverged();
+  StoreBatchStates();
   // Small islands still unconverged are solved exactly, then swept again
   // from there so that friction and the normal impulses agree.
-  if (FinishIslandsExactly()) SweepUntilConverged();
+  if (FinishIslandsExactly()) {
+    LoadBatchStates();
+    SweepUntilConverged();
+    StoreBatchStates();
+  }
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
   // without touching the real velocities, so no energy is added. The same
@@ -233,6 +244,16 @@ void ContactSolver::SweepUntilConverged() {
   for (const std::size_t updates : row_updates) velocity_row_updates_ += updates;
 }
 
+void ContactSolver::StoreBatchStates() {
+  if (!settings_.batch_independent_runs) return;
+  for (const RestingBatches& group : batches_) StoreBatchState(group, &rows_);
+}
+
+void ContactSolver::LoadBatchStates() {
+  if (!settings_.batch_independent_runs) return;
+  for (RestingBatches& group : batches_) LoadBatchState(rows_, &group);
+}
+
 int ContactSolver::SweepGroupUntilConverged(std::size_t group, std::size_t* row_updates) {
   const double tolerance_squared = settings_.velocity_tolerance * settings_.velocity_tolerance;
   std::size_t sweeping = 0;
@@ -241,7 +262,11 @@ int ContactSolver::SweepGroupUntilConverged(std::size_t group, std::size_t* row_
   }
   int sweeps = 0;
   while (sweeping > 0 && sweeps < settings_.velocity_iterations) {
-    SweepSchedule</*kPseudo=*/false>(schedules_[group]);
+    if (settings_.batch_independent_runs) {
+      SweepBatches(&batches_[group], &bodies_, &islands_);
+    } else {
+      SweepSchedule</*kPseudo=*/false>(schedules_[group]);
+    }
     ++sweeps;
     for (std::uint32_t index = 0; index < islands_.size(); ++index) {
       RestingIsland& island = islands_[index];

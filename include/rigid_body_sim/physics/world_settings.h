@@ -23,6 +23,11 @@ struct SolverSettings {
   // by side (ScheduleRuns), which gives bit for bit the result of updating
   // one run at a time in manifold order (false, the reference) in less time.
   bool interleave_independent_runs = true;
+  // Whether a sweep updates up to four runs of rows that share no moving
+  // body at once, one per lane of a SIMD vector (resting_batches.h), which
+  // gives bit for bit the result of the order above in less time; false
+  // sweeps in that order, the reference.
+  bool batch_independent_runs = true;
   // m/s; epsilon of the classification: colliding when v_r < -epsilon,
   // resting when |v_r| <= epsilon.
   double collision_velocity_threshold = 0.01;
