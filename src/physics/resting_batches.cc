@@ -78,7 +78,8 @@ void PlaceRuns(std::uint32_t begin, std::uint32_t end, std::uint8_t moving,
   }
 }
 
-// Copies a row's own fields into lane `lane` of its block.
+// Copies a row's own fields, and its impulses, into lane `lane` of its
+// block.
 void PackRow(const RestingRow& row, int lane, RowBlock* block) {
   for (int axis = 0; axis < 3; ++axis) {
     block->r_a[axis][lane] = row.r_a[axis];
@@ -93,6 +94,17 @@ void PackRow(const RestingRow& row, int lane, RowBlock* block) {
   block->normal_coupling[0][lane] = row.normal_coupling[0];
   block->normal_coupling[1][lane] = row.normal_coupling[1];
   block->target[lane] = row.target;
+  block->normal_impulse[lane] = row.normal_impulse;
+  block->tangent_impulse[0][lane] = row.tangent_impulse[0];
+  block->tangent_impulse[1][lane] = row.tangent_impulse[1];
+  for (int axis = 0; axis < 3; ++axis) block->last_velocity[axis][lane] = row.last_velocity[axis];
+}
+
+// Zero in every field of a lane without a row, so that its arithmetic is
+// harmless (row_count tells the sweep which lanes hold rows).
+void ClearLane(int lane, RowBlock* block) {
+  static const RestingRow kNoRow;  // zero lever arms, responses, masses and impulses
+  PackRow(kNoRow, lane, block);
 }
 
 // Calls visit(row, lane, block) for every row of every batch.
@@ -129,13 +141,21 @@ void BuildRestingBatches(const std::vector<SweepTask>& schedule,
     batch.block_begin = block_count;
     block_count += batch.block_count;
   }
-  // Zero in every field of an absent lane, so that its arithmetic is
-  // harmless; row_count tells the others.
-  batches->blocks.assign(block_count, RowBlock{});
-  ForEachRow(batches, [&](std::uint32_t row, int lane, RowBlock* block) {
-    PackRow(rows[row], lane, block);
-  });
-  LoadBatchState(rows, batches);
+  // Blocks are reused from step to step: every lane is written.
+  batches->blocks.resize(block_count);
+  for (const RunBatch& batch : batches->batches) {
+    RowBlock* blocks = batches->blocks.data() + batch.block_begin;
+    for (int lane = 0; lane < kBatchLanes; ++lane) {
+      const auto count = static_cast<std::uint32_t>(batch.row_count[lane]);
+      for (std::uint32_t k = 0; k < batch.block_count; ++k) {
+        if (k < count) {
+          PackRow(rows[batch.row_begin[lane] + k], lane, &blocks[k]);
+        } else {
+          ClearLane(lane, &blocks[k]);
+        }
+      }
+    }
+  }
 }
 
 void StoreBatchState(const RestingBatches& batches, std::vector<RestingRow>* rows) {
