@@ -1,20 +1,20 @@
 // The resting solve's sweep over batches: up to four runs of rows (each run
-// the adjacent rows of one body pair) that share no moving body, updated at
-// once, one run per lane of a SIMD vector.
+// the rows of one manifold) that share no moving body, updated at once, one
+// run per lane of a SIMD vector.
 //
 // Why it gives the reference sweep bit for bit: a projected Gauss-Seidel
 // update reads and writes only its row and its two bodies' velocities, so
 // any order that keeps, for each moving body, the order of the rows that
 // touch it, gives every update the same operands as the reference order
 // does. The batching below places each run in the first batch after the
-// last batch that holds one of its moving bodies (list scheduling of the
-// dependence graph; Coffman and Graham, "Optimal scheduling for
-// two-processor systems", 1972), so per body the order is kept; and each
-// lane does the reference update's floating-point operations, in the same
-// order (resting_row.h: Eigen's 3-vector dot product adds left to right),
-// with no fused multiply-add. Box2D v3 (Catto 2024, "Solver2D" and the v3
-// release notes) updates constraints in SIMD lanes the same way, but in
-// graph-colour order, which changes the result; this keeps it.
+// last batch that holds one of its moving bodies (greedy list scheduling
+// of the dependence graph, four lanes per time slot; Graham 1966, "Bounds
+// for certain multiprocessing anomalies"), so per body the order is kept;
+// and each lane does the reference update's floating-point operations, in
+// the same order, with no fused multiply-add. Box2D v3 (Catto 2024,
+// src/contact_solver.c) also updates contacts in SIMD lanes, but over graph
+// colours, which changes the Gauss-Seidel order and so the result; this
+// keeps it.
 #ifndef RIGID_BODY_SIM_PHYSICS_RESTING_BATCHES_H_
 #define RIGID_BODY_SIM_PHYSICS_RESTING_BATCHES_H_
 
