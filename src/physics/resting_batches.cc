@@ -48,6 +48,7 @@ void PlaceRun(std::uint32_t begin, std::uint32_t end, std::uint8_t moving,
   batch.moving[lane] = moving;
   batch.row_count[lane] = end - begin;
   batch.block_count = std::max(batch.block_count, end - begin);
+  for (std::uint32_t r = begin; r < end; ++r) batch.penetrates |= rows[r].depth > 0.0;
   for (int axis = 0; axis < 3; ++axis) {
     batch.normal[axis][lane] = first.normal[axis];
     batch.tangent[0][axis][lane] = first.tangent[0][axis];
@@ -98,6 +99,8 @@ void PackRow(const RestingRow& row, int lane, RowBlock* block) {
   block->tangent_impulse[0][lane] = row.tangent_impulse[0];
   block->tangent_impulse[1][lane] = row.tangent_impulse[1];
   for (int axis = 0; axis < 3; ++axis) block->last_velocity[axis][lane] = row.last_velocity[axis];
+  block->depth[lane] = row.depth;
+  block->pseudo_impulse[lane] = row.pseudo_impulse;
 }
 
 // Zero in every field of a lane without a row, so that its arithmetic is
@@ -165,6 +168,7 @@ void StoreBatchState(const RestingBatches& batches, std::vector<RestingRow>* row
     row.tangent_impulse = {block->tangent_impulse[0][lane], block->tangent_impulse[1][lane]};
     row.last_velocity = Vec3(block->last_velocity[0][lane], block->last_velocity[1][lane],
                              block->last_velocity[2][lane]);
+    row.pseudo_impulse = block->pseudo_impulse[lane];
   });
 }
 
@@ -175,6 +179,7 @@ void LoadBatchState(const std::vector<RestingRow>& rows, RestingBatches* batches
     block->tangent_impulse[0][lane] = row.tangent_impulse[0];
     block->tangent_impulse[1][lane] = row.tangent_impulse[1];
     for (int axis = 0; axis < 3; ++axis) block->last_velocity[axis][lane] = row.last_velocity[axis];
+    block->pseudo_impulse[lane] = row.pseudo_impulse;
   });
 }
 

@@ -57,6 +57,8 @@ struct RowBlock {
   LaneDoubles normal_impulse;      // N s
   LaneDoubles tangent_impulse[2];  // N s
   LaneDoubles last_velocity[3];    // m/s
+  LaneDoubles depth;               // m, penetration beyond the slop
+  LaneDoubles pseudo_impulse;      // N s, split impulse
 };
 
 // Up to kBatchLanes runs, lane l holding rows [row_begin[l], row_end[l])
@@ -73,6 +75,7 @@ struct RunBatch {
   std::uint32_t block_begin = 0;
   std::uint32_t block_count = 0;
   std::uint32_t lanes = 0;  // lanes holding a run: the first `lanes`
+  bool penetrates = false;  // whether a row penetrates beyond the slop
   std::array<std::uint32_t, kBatchLanes> row_begin{};
   std::array<std::uint32_t, kBatchLanes> row_end{};
   std::array<std::uint32_t, kBatchLanes> body_a{};
@@ -110,6 +113,12 @@ void LoadBatchState(const std::vector<RestingRow>& rows, RestingBatches* batches
 // island's largest |v - v_previous sweep|^2, as SweepSchedule does.
 void SweepBatches(RestingBatches* batches, std::vector<SolverBody>* bodies,
                   std::vector<RestingIsland>* islands);
+
+// One sweep of the split impulse's update (UpdatePseudoRow) over the
+// batches, on the pseudo velocities, every island; a batch with no row
+// penetrating beyond the slop is skipped, as its updates change nothing.
+void SweepPseudoBatches(RestingBatches* batches, std::vector<SolverBody>* bodies,
+                        double position_correction, double inverse_dt);
 
 }  // namespace rigid_body_sim::physics
 

@@ -55,7 +55,6 @@ void ContactSolver::SolveRestingContacts() {
   if (FinishIslandsExactly()) {
     LoadBatchStates();
     SweepUntilConverged();
-    StoreBatchStates();
   }
 
   // Split impulse: pseudo velocities remove penetration beyond the slop
@@ -63,7 +62,8 @@ void ContactSolver::SolveRestingContacts() {
   // schedules, every island, each group on its thread; a task none of whose
   // rows penetrates beyond the slop is left out, as its updates change
   // nothing (UpdatePseudoRow returns at once), so the result is the same
-  // bit for bit while a settled pile's sweeps skip most rows.
+  // bit for bit while a settled pile's sweeps skip most rows. Batched, the
+  // same in SIMD lanes, skipping batches with no such row.
   pseudo_schedules_.resize(schedules_.size());
   auto penetrates = [this](std::uint32_t begin, std::uint32_t end) {
     for (std::uint32_t r = begin; r < end; ++r) {
@@ -72,6 +72,13 @@ void ContactSolver::SolveRestingContacts() {
     return false;
   };
   RunGroups(pool_, schedules_.size(), [&](std::size_t group) {
+    if (settings_.batch_independent_runs) {
+      for (int iteration = 0; iteration < settings_.position_iterations; ++iteration) {
+        SweepPseudoBatches(&batches_[group], &bodies_, settings_.position_correction,
+                           1.0 / time_step_);
+      }
+      return;
+    }
     std::vector<SweepTask>& pseudo = pseudo_schedules_[group];
     pseudo.clear();
     for (const SweepTask& task : schedules_[group]) {
@@ -84,6 +91,7 @@ void ContactSolver::SolveRestingContacts() {
       SweepSchedule</*kPseudo=*/true>(pseudo);
     }
   });
+  StoreBatchStates();
   for (const RestingRow& row : rows_) {
     row.point->normal_impulse = row.normal_impulse;
     row.point->tangent_impulse = row.tangent_impulse;
