@@ -69,7 +69,9 @@ struct OurSettingsOverrides {
   std::optional<double> time_to_sleep;       // s an island must stay slow before it sleeps, > 0
   std::optional<double> velocity_tolerance;  // m/s, the sweeps' early stop, >= 0
   std::optional<bool> interleave_independent_runs;  // the sweeps pair independent runs of rows
-  std::optional<int> threads;                       // WorldSettings::threads, [0, 256]
+  std::optional<bool>
+      batch_independent_runs;  // the sweeps update runs four at a time in SIMD lanes
+  std::optional<int> threads;  // WorldSettings::threads, [0, 256]
 };
 
 // The engines under test: ours on one thread; Bullet with its defaults;

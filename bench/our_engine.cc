@@ -98,6 +98,8 @@ class OurEngine : public Engine {
     solver.velocity_tolerance = overrides.velocity_tolerance.value_or(solver.velocity_tolerance);
     solver.interleave_independent_runs =
         overrides.interleave_independent_runs.value_or(solver.interleave_independent_runs);
+    solver.batch_independent_runs =
+        overrides.batch_independent_runs.value_or(solver.batch_independent_runs);
     settings.sleep.time_to_sleep = overrides.time_to_sleep.value_or(settings.sleep.time_to_sleep);
     settings.threads = overrides.threads.value_or(settings.threads);
     assert(physics::ValidateWorldSettings(settings).ok());

@@ -16,11 +16,12 @@
 //                      [--hull-bench PATH]
 //                      [--velocity-iterations N] [--time-to-sleep S]
 //                      [--velocity-tolerance V] [--interleave-independent-runs 0|1]
-//                      [--hill-amplitude A]
+//                      [--batch-independent-runs 0|1] [--hill-amplitude A]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
 //   their number of runs. --velocity-iterations, --time-to-sleep (s),
-//   --velocity-tolerance (m/s) and --interleave-independent-runs run our
+//   --velocity-tolerance (m/s), --interleave-independent-runs and
+//   --batch-independent-runs run our
 //   engine with those solver and sleep settings instead of the defaults, to
 //   measure what a setting costs or buys; the header says so
 //   (--time-to-sleep also reaches bullet_oursleep). --hill-amplitude A (m,
@@ -67,6 +68,12 @@ std::optional<double> ParseNumber(const std::string& text) {
   const double value = std::strtod(text.c_str(), &end);
   if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) return std::nullopt;
   return value;
+}
+
+// "0" or "1" as a flag, or nothing.
+std::optional<bool> ParseFlag(const std::string& text) {
+  if (text == "0" || text == "1") return text == "1";
+  return std::nullopt;
 }
 
 Options ParseOptions(int argc, char** argv) {
@@ -117,11 +124,14 @@ Options ParseOptions(int argc, char** argv) {
       } else {
         options.hill_amplitude = *amplitude;
       }
-    } else if (key == "--interleave-independent-runs") {
-      if (value != "0" && value != "1") {
-        options.error = "--interleave-independent-runs wants 0 or 1, got " + value;
+    } else if (key == "--interleave-independent-runs" || key == "--batch-independent-runs") {
+      const std::optional<bool> flag = ParseFlag(value);
+      if (!flag) {
+        options.error = key + " wants 0 or 1, got " + value;
+      } else if (key == "--interleave-independent-runs") {
+        options.overrides.interleave_independent_runs = *flag;
       } else {
-        options.overrides.interleave_independent_runs = value == "1";
+        options.overrides.batch_independent_runs = *flag;
       }
     } else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
@@ -184,6 +194,10 @@ void PrintHeader(const Options& options, double window_seconds) {
   if (overrides.interleave_independent_runs) {
     std::printf("ours: interleave_independent_runs = %s\n",
                 *overrides.interleave_independent_runs ? "true" : "false");
+  }
+  if (overrides.batch_independent_runs) {
+    std::printf("ours: batch_independent_runs = %s\n",
+                *overrides.batch_independent_runs ? "true" : "false");
   }
   if (options.hill_amplitude != 0.5) {
     std::printf("terrain_100: hills of %g m instead of 0.5 m\n", options.hill_amplitude);
