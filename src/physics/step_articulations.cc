@@ -452,6 +452,24 @@ void WorldImpl::CorrectLinkPenetration(double dt, const std::vector<int>& slot_o
     row.target = target;
     pseudo.AddRow(std::move(row));
   }
+  // The joints' own rows (motors within their effort, servos, limits,
+  // friction, mimics) hold in the correction as in the velocity solve:
+  // pushing a box out of a link may turn a joint only as far as a push on
+  // it could, not freely past the motor that holds it.
+  for (const ConstraintRow& from : articulation_solver_.rows()) {
+    if (from.articulation < 0 || from.a.kind != RowSide::Kind::kArticulation ||
+        pseudo_slot[from.a.slot] < 0) {
+      continue;
+    }
+    ConstraintRow row = from;
+    row.a = remap(from.a);
+    row.b = remap(from.b);
+    row.target = 0.0;
+    row.impulse = 0.0;
+    row.colliding = false;
+    row.bounce = 0.0;
+    pseudo.AddRow(std::move(row));
+  }
   pseudo.Solve(kMaxSweeps, kSweepTolerance);
 
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {

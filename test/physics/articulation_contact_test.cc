@@ -194,6 +194,44 @@ TEST(ArticulationContactTest, RigidBallBouncesOnALinkToRestitutionSquared) {
   }
 }
 
+// A ball spawned 1 cm into a flap that a velocity motor holds at 0 rad/s
+// (effort 100 N m), without gravity. The split impulse pushes the ball out;
+// the motor's row holds in the correction as in the velocity solve, so the
+// flap does not turn (a 1 kg ball pushed out at 0.2 of its depth per step
+// needs a small part of the motor's 100 N m). Without the joint's rows in
+// the correction, the flap, an eighth of the ball's mass, was pushed aside.
+TEST(ArticulationContactTest, SplitImpulseDoesNotTurnAJointItsMotorHolds) {
+  constexpr double kRadius = 0.05;  // m
+  constexpr double kDepth = 0.01;   // m, into the flap's +x face
+  WorldSettings settings;
+  settings.time_step = kDt;
+  settings.gravity = Vec3::Zero();
+  World world(settings);
+  ArticulationDef def = BoxWithFlap(0.0);
+  def.fixed_base = true;
+  def.joints[0].effort_limit = 100.0;
+  ShapeDef flap;  // the flap's 5 cm cube, its centre 5 cm above the hinge
+  flap.geometry =
+      std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3(0.05, 0.05, 0.05)));
+  flap.body_from_shape.translation = Vec3(0, 0, 0.05);
+  flap.material = MakeMaterial(0.0, 0.0);
+  def.links[1].shapes.push_back(flap);
+  const ArticulationId arm = world.CreateArticulation(def).value();
+  ASSERT_TRUE(world.SetJointCommand(arm, 0, {JointCommandMode::kVelocity, 0.0, 0.0, 0.0}).ok());
+  SphereSpec spec;
+  spec.radius = kRadius;
+  spec.world_from_body = Translation(0.025 + kRadius - kDepth, 0.0, 0.15);
+  spec.material = MakeMaterial(0.0, 0.0);
+  const BodyId ball = AddSphere(&world, spec);
+  for (int step = 0; step < 240; ++step) world.Step();
+  EXPECT_NEAR(world.GetJointStates(arm)[0].position, 0.0, 1e-9);
+  // Pushed out to within the slop, with no launch speed: the split impulse
+  // moves positions only.
+  EXPECT_GT(world.GetPose(ball).translation.x(),
+            0.025 + kRadius - settings.solver.penetration_slop - 1e-6);
+  EXPECT_LT(world.GetLinearVelocity(ball).norm(), 1e-9);
+}
+
 LinkDef BoxLink(double mass, const Vec3& size, double friction) {
   LinkDef link;
   link.mass_properties = BoxMassProperties(mass / size.prod(), size);
