@@ -79,8 +79,17 @@ void PlaceRuns(std::uint32_t begin, std::uint32_t end, std::uint8_t moving,
   }
 }
 
-// Copies a row's own fields, and its impulses, into lane `lane` of its
-// block.
+// Copies what a sweep changes in a row (its impulses and last velocity)
+// into lane `lane` of its block.
+void PackState(const RestingRow& row, int lane, RowBlock* block) {
+  block->normal_impulse[lane] = row.normal_impulse;
+  block->tangent_impulse[0][lane] = row.tangent_impulse[0];
+  block->tangent_impulse[1][lane] = row.tangent_impulse[1];
+  for (int axis = 0; axis < 3; ++axis) block->last_velocity[axis][lane] = row.last_velocity[axis];
+  block->pseudo_impulse[lane] = row.pseudo_impulse;
+}
+
+// Copies a row's own fields, and its state, into lane `lane` of its block.
 void PackRow(const RestingRow& row, int lane, RowBlock* block) {
   for (int axis = 0; axis < 3; ++axis) {
     block->r_a[axis][lane] = row.r_a[axis];
@@ -95,12 +104,8 @@ void PackRow(const RestingRow& row, int lane, RowBlock* block) {
   block->normal_coupling[0][lane] = row.normal_coupling[0];
   block->normal_coupling[1][lane] = row.normal_coupling[1];
   block->target[lane] = row.target;
-  block->normal_impulse[lane] = row.normal_impulse;
-  block->tangent_impulse[0][lane] = row.tangent_impulse[0];
-  block->tangent_impulse[1][lane] = row.tangent_impulse[1];
-  for (int axis = 0; axis < 3; ++axis) block->last_velocity[axis][lane] = row.last_velocity[axis];
   block->depth[lane] = row.depth;
-  block->pseudo_impulse[lane] = row.pseudo_impulse;
+  PackState(row, lane, block);
 }
 
 // Zero in every field of a lane without a row, so that its arithmetic is
@@ -174,12 +179,7 @@ void StoreBatchState(const RestingBatches& batches, std::vector<RestingRow>* row
 
 void LoadBatchState(const std::vector<RestingRow>& rows, RestingBatches* batches) {
   ForEachRow(batches, [&](std::uint32_t index, int lane, RowBlock* block) {
-    const RestingRow& row = rows[index];
-    block->normal_impulse[lane] = row.normal_impulse;
-    block->tangent_impulse[0][lane] = row.tangent_impulse[0];
-    block->tangent_impulse[1][lane] = row.tangent_impulse[1];
-    for (int axis = 0; axis < 3; ++axis) block->last_velocity[axis][lane] = row.last_velocity[axis];
-    block->pseudo_impulse[lane] = row.pseudo_impulse;
+    PackState(rows[index], lane, block);
   });
 }
 

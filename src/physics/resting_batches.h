@@ -103,8 +103,8 @@ void BuildRestingBatches(const std::vector<SweepTask>& schedule,
                          const std::vector<std::uint32_t>& row_island, std::size_t body_count,
                          RestingBatches* batches);
 
-// Copies what a sweep changes in a row (its impulses and last velocity)
-// from the blocks to rows, or back.
+// Copies what a sweep changes in a row (its impulses, split impulse and
+// last velocity) from the blocks to rows, or back.
 void StoreBatchState(const RestingBatches& batches, std::vector<RestingRow>* rows);
 void LoadBatchState(const std::vector<RestingRow>& rows, RestingBatches* batches);
 
