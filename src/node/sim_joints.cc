@@ -39,7 +39,19 @@ void SimNode::AdvertiseJointTopicsLocked(const Model& model) {
 void SimNode::RemoveJointTopics(const std::string& model_name) {
   trajectories_.erase(model_name);
   std::lock_guard<std::mutex> lock(joint_topics_mutex_);
-  joint_topics_.erase(model_name);
+  const auto topics = joint_topics_.find(model_name);
+  if (topics == joint_topics_.end()) return;
+  retired_joint_topics_.push_back(std::move(topics->second));
+  joint_topics_.erase(topics);
+}
+
+void SimNode::DestroyRetiredJointTopics() {
+  std::vector<JointTopics> retired;
+  {
+    std::lock_guard<std::mutex> lock(joint_topics_mutex_);
+    retired.swap(retired_joint_topics_);
+  }
+  // Destroyed here, with no lock held.
 }
 
 namespace {

@@ -95,6 +95,7 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
     outbox.body_markers.emplace().markers = DeleteMarkers(request.name, marker_count);
     if (was_static) outbox.tf_static = StaticTfLocked();
   }
+  DestroyRetiredJointTopics();
   Publish(std::move(outbox));
   response.success = true;
   response.message = "deleted '" + request.name + "'";

@@ -109,7 +109,13 @@ class SimNode {
   // The articulated models' topics (sim_joints.cc): ~<model>/joint_states
   // and ~<model>/joint_command.
   void AdvertiseJointTopicsLocked(const Model& model);
+  // Takes the model's topics out of joint_topics_, under the world lock;
+  // DestroyRetiredJointTopics destroys them after it is released.
+  // Destroying a subscriber waits for its running callback, and a
+  // joint_command callback waits for the world lock: destroyed under it,
+  // a command arriving with the delete would deadlock the node.
   void RemoveJointTopics(const std::string& model_name);
+  void DestroyRetiredJointTopics();
   void OnJointCommand(const std::string& model_name, const sensor_msgs::JointState& command);
   void OnJointTrajectory(const std::string& model_name,
                          const trajectory_msgs::JointTrajectory& trajectory);
@@ -229,6 +235,7 @@ class SimNode {
   std::map<std::string, ActiveTrajectory> trajectories_;  // by model, under mutex_
   std::mutex joint_topics_mutex_;
   std::map<std::string, JointTopics> joint_topics_;  // by model
+  std::vector<JointTopics> retired_joint_topics_;    // of deleted models, to destroy
   std::unique_ptr<SimDiagnostics> diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<rigid_body_sim::PhysicsConfig>> reconfigure_;
