@@ -206,8 +206,13 @@ class ContactSolver {
   // SweepUntilConverged for one group's islands; returns its sweeps and adds
   // its row updates to *row_updates.
   int SweepGroupUntilConverged(std::size_t group, std::size_t* row_updates);
-  // Returns whether it finished any island, which it then marks unconverged.
-  bool FinishIslandsExactly();
+  // Whether an island is unconverged and small enough to finish exactly
+  // (max_pivoting_points), and whether any is.
+  bool FinishesExactly(const RestingIsland& island) const;
+  bool AnyIslandToFinish() const;
+  // Finishes those islands, which it then marks unconverged, the others
+  // converged.
+  void FinishIslandsExactly();
   void ComputeMasses();
   // Applies a collision round's restitution impulses, scaled so that they
   // add no kinetic energy; returns the scale (collision_impulses.cc).

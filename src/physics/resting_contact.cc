@@ -49,10 +49,11 @@ void ContactSolver::SolveRestingContacts() {
   velocity_sweeps_ = 0;
   velocity_row_updates_ = 0;
   SweepUntilConverged();
-  StoreBatchStates();
   // Small islands still unconverged are solved exactly, then swept again
   // from there so that friction and the normal impulses agree.
-  if (FinishIslandsExactly()) {
+  if (AnyIslandToFinish()) {
+    StoreBatchStates();
+    FinishIslandsExactly();
     LoadBatchStates();
     SweepUntilConverged();
   }

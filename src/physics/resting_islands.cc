@@ -193,13 +193,19 @@ void ContactSolver::FindIslands() {
 // where a light body carries a heavy one; pivoting does not depend on the
 // masses. Friction that the new normal impulses leave outside its cone is
 // projected back onto it.
-bool ContactSolver::FinishIslandsExactly() {
+bool ContactSolver::FinishesExactly(const RestingIsland& island) const {
+  return !island.converged && static_cast<int>(island.row_count) <= settings_.max_pivoting_points;
+}
+
+bool ContactSolver::AnyIslandToFinish() const {
+  return std::any_of(islands_.begin(), islands_.end(),
+                     [this](const RestingIsland& island) { return FinishesExactly(island); });
+}
+
+void ContactSolver::FinishIslandsExactly() {
   // The rows of the islands to finish, grouped by island (a counting sort):
   // island i's are exact_rows_[exact_begin_[i], exact_begin_[i + 1]).
-  auto finishes = [&](const RestingIsland& island) {
-    return !island.converged && static_cast<int>(island.row_count) <= settings_.max_pivoting_points;
-  };
-  if (std::none_of(islands_.begin(), islands_.end(), finishes)) return false;
+  auto finishes = [this](const RestingIsland& island) { return FinishesExactly(island); };
   exact_begin_.assign(islands_.size() + 1, 0);
   for (std::uint32_t island = 0; island < islands_.size(); ++island) {
     const std::uint32_t count = finishes(islands_[island]) ? islands_[island].row_count : 0;
@@ -247,7 +253,6 @@ bool ContactSolver::FinishIslandsExactly() {
   for (std::uint32_t island = 0; island < islands_.size(); ++island) {
     islands_[island].converged = exact_begin_[island + 1] == exact_begin_[island];
   }
-  return true;
 }
 
 }  // namespace rigid_body_sim::physics
