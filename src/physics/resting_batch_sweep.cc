@@ -306,13 +306,27 @@ template <bool kPseudo>
 // Built twice, for AVX2 (four lanes per instruction) and for the baseline
 // x86-64 (two), the loader picking the one the processor runs; neither
 // fuses a multiply and an add, so both give the scalar sweep's result.
-[[gnu::target_clones("avx2", "default")]] void SweepBatches(RestingBatches* batches,
+// ThreadSanitizer instruments the generated ifunc resolver, which the
+// loader runs before the sanitizer's runtime is up, so a TSan build (and
+// any non-x86 target) gets the one baseline version.
+#if defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define RBS_THREAD_SANITIZER 1
+#endif
+#endif
+#if defined(__x86_64__) && !defined(__SANITIZE_THREAD__) && !defined(RBS_THREAD_SANITIZER)
+#define RBS_SIMD_CLONES [[gnu::target_clones("avx2", "default")]]
+#else
+#define RBS_SIMD_CLONES
+#endif
+
+RBS_SIMD_CLONES void SweepBatches(RestingBatches* batches,
                                                             std::vector<SolverBody>* bodies,
                                                             std::vector<RestingIsland>* islands) {
   SweepAllBatches(batches, bodies, islands);
 }
 
-[[gnu::target_clones("avx2", "default")]] void SweepPseudoBatches(RestingBatches* batches,
+RBS_SIMD_CLONES void SweepPseudoBatches(RestingBatches* batches,
                                                                   std::vector<SolverBody>* bodies,
                                                                   double position_correction,
                                                                   double inverse_dt) {
