@@ -22,19 +22,25 @@ constexpr int kThreads = 4;
 constexpr int kIterations = 200;
 constexpr double kSpawnHeight = 20.0;  // m
 
-// A pendulum hinged to the world: a 1 kg ball on a massless 1 m rod.
-constexpr char kPendulumUrdf[] = R"(<robot name="pendulum">
-  <link name="world"/>
-  <joint name="mount" type="fixed"><parent link="world"/><child link="pivot"/></joint>
-  <link name="pivot"><inertial><mass value="0.1"/>
-    <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="hinge" type="continuous"><parent link="pivot"/><child link="bob"/>
-    <axis xyz="0 1 0"/></joint>
-  <link name="bob"><inertial><origin xyz="0 0 -1"/><mass value="1"/>
-    <inertia ixx="4e-5" iyy="4e-5" izz="4e-5" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 -1"/><geometry><sphere radius="0.01"/></geometry></collision>
-  </link>
-</robot>)";
+// A chain of `links` links hinged to the world and to each other about y,
+// joints j0, j1, ...: each link a 1 kg ball of radius 0.05 m, 0.2 m below
+// its hinge.
+std::string ChainUrdf(int links) {
+  std::string urdf = R"(<robot name="chain"><link name="world"/>)";
+  std::string parent = "world";
+  for (int k = 0; k < links; ++k) {
+    const std::string link = "l" + std::to_string(k);
+    urdf += "<joint name=\"j" + std::to_string(k) + "\" type=\"continuous\"><parent link=\"" +
+            parent + "\"/><child link=\"" + link + "\"/><origin xyz=\"0 0 " +
+            (k == 0 ? "3" : "-0.2") + "\"/><axis xyz=\"0 1 0\"/></joint>";
+    urdf += "<link name=\"" + link + R"("><inertial><origin xyz="0 0 -0.2"/><mass value="1"/>)" +
+            R"(<inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial>)" +
+            R"(<collision><origin xyz="0 0 -0.2"/><geometry><sphere radius="0.05"/></geometry>)" +
+            "</collision></link>";
+    parent = link;
+  }
+  return urdf + "</robot>";
+}
 
 TEST(ConcurrencyTest, ParallelSpawnGetStateDeleteGiveConsistentAnswers) {
   SimClient setup;
@@ -87,42 +93,56 @@ TEST(ConcurrencyTest, ParallelSpawnGetStateDeleteGiveConsistentAnswers) {
 // A model deleted while joint commands stream in: roscpp's unsubscribe
 // waits for a running callback, and the node's command callback waits for
 // the world, so destroying the subscriber under the world's lock would hang
-// the node. Commands come from a latched publisher, so each new subscriber
-// gets one at once, and the world steps as fast as it can, so a callback is
-// often waiting for the lock when the delete takes it.
+// the node. Each cycle spawns the model, waits until its command
+// subscriber is connected to the test's flooding publisher, and deletes it
+// with commands still queued, so a callback is often waiting for the world
+// when the delete takes it.
 TEST(ConcurrencyTest, DeletingAModelWhileItsJointCommandsArriveNeverHangs) {
   constexpr int kCycles = 60;
+  constexpr int kLinks = 30;
   constexpr double kTimeout = 240.0;  // s of wall time for all cycles
   SimClient setup;
   ASSERT_TRUE(setup.WaitForServices(20.0));
   ASSERT_TRUE(setup.SetPaused(false));
-  ros::NodeHandle node("/rigid_body_sim");
-  ros::Publisher command =
-      node.advertise<sensor_msgs::JointState>("busy_pendulum/joint_command", 1, /*latch=*/true);
-  std::atomic<bool> stop{false};
-  std::thread commander([&] {
-    sensor_msgs::JointState message;
-    message.name = {"hinge"};
-    message.effort = {0.5};
-    while (!stop.load()) {
-      command.publish(message);
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-  });
   struct Progress {
+    ros::Publisher command;
     std::atomic<int> cycles_done{0};
     std::atomic<int> failures{0};
   };
+  // Shared with a detached thread: a hung node leaves it blocked in a
+  // service call for good.
   const auto progress = std::make_shared<Progress>();
-  // Detached, holding its own share of the progress: a hung node leaves it
-  // blocked in a service call for good.
+  ros::NodeHandle node("/rigid_body_sim");
+  progress->command = node.advertise<sensor_msgs::JointState>("busy_chain/joint_command", 1);
+  std::atomic<bool> stop{false};
+  std::thread commander([&] {
+    sensor_msgs::JointState message;
+    message.name = {"j0"};
+    message.effort = {0.5};
+    while (!stop.load()) {
+      progress->command.publish(message);
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+  });
   std::thread([progress] {
     SimClient client(/*persistent=*/true);
+    const std::string urdf = ChainUrdf(kLinks);
+    const auto subscribers = [&progress](bool connected) {
+      return WaitFor([&] { return (progress->command.getNumSubscribers() > 0) == connected; },
+                     10.0);
+    };
     for (int i = 0; i < kCycles; ++i) {
-      const auto spawned = client.SpawnUrdf("busy_pendulum", kPendulumUrdf, MakePose(0, 0, 3));
-      std::this_thread::sleep_for(std::chrono::milliseconds(20 + i % 7 * 5));
-      const auto deleted = client.Delete("busy_pendulum");
-      if (!spawned.success || !deleted.success) ++progress->failures;
+      const auto spawned = client.SpawnUrdf("busy_chain", urdf, MakePose(0, 0, 0));
+      const bool connected = subscribers(true);
+      std::this_thread::sleep_for(std::chrono::milliseconds(i % 7 * 3));
+      const auto deleted = client.Delete("busy_chain");
+      const bool disconnected = subscribers(false);
+      if (!spawned.success || !connected || !deleted.success || !disconnected) {
+        ++progress->failures;
+        ADD_FAILURE() << "cycle " << i << ": spawn '" << spawned.message << "', connected "
+                      << connected << ", delete '" << deleted.message << "', disconnected "
+                      << disconnected;
+      }
       ++progress->cycles_done;
     }
   }).detach();
