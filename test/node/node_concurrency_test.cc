@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -107,7 +108,8 @@ TEST(ConcurrencyTest, DeletingAModelWhileItsJointCommandsArriveNeverHangs) {
   struct Progress {
     ros::Publisher command;
     std::atomic<int> cycles_done{0};
-    std::atomic<int> failures{0};
+    std::mutex mutex;
+    std::vector<std::string> failures;  // guarded by mutex
   };
   // Shared with a detached thread: a hung node leaves it blocked in a
   // service call for good.
@@ -137,11 +139,13 @@ TEST(ConcurrencyTest, DeletingAModelWhileItsJointCommandsArriveNeverHangs) {
       std::this_thread::sleep_for(std::chrono::milliseconds(i % 7 * 3));
       const auto deleted = client.Delete("busy_chain");
       const bool disconnected = subscribers(false);
+      // Reported by the test's thread: this one may outlive the test.
       if (!spawned.success || !connected || !deleted.success || !disconnected) {
-        ++progress->failures;
-        ADD_FAILURE() << "cycle " << i << ": spawn '" << spawned.message << "', connected "
-                      << connected << ", delete '" << deleted.message << "', disconnected "
-                      << disconnected;
+        const std::lock_guard<std::mutex> lock(progress->mutex);
+        progress->failures.push_back(
+            "cycle " + std::to_string(i) + ": spawn '" + spawned.message + "', connected " +
+            std::to_string(connected) + ", delete '" + deleted.message + "', disconnected " +
+            std::to_string(disconnected));
       }
       ++progress->cycles_done;
     }
@@ -150,9 +154,10 @@ TEST(ConcurrencyTest, DeletingAModelWhileItsJointCommandsArriveNeverHangs) {
       WaitFor([&] { return progress->cycles_done.load() == kCycles; }, kTimeout);
   stop = true;
   commander.join();
-  ASSERT_TRUE(finished) << "the node stopped answering after " << progress->cycles_done.load()
+  EXPECT_TRUE(finished) << "the node stopped answering after " << progress->cycles_done.load()
                         << " of " << kCycles << " spawn and delete cycles";
-  EXPECT_EQ(progress->failures.load(), 0);
+  const std::lock_guard<std::mutex> lock(progress->mutex);
+  for (const std::string& failure : progress->failures) ADD_FAILURE() << failure;
 }
 
 }  // namespace
