@@ -320,16 +320,13 @@ template <bool kPseudo>
 #define RBS_SIMD_CLONES
 #endif
 
-RBS_SIMD_CLONES void SweepBatches(RestingBatches* batches,
-                                                            std::vector<SolverBody>* bodies,
-                                                            std::vector<RestingIsland>* islands) {
+RBS_SIMD_CLONES void SweepBatches(RestingBatches* batches, std::vector<SolverBody>* bodies,
+                                  std::vector<RestingIsland>* islands) {
   SweepAllBatches(batches, bodies, islands);
 }
 
-RBS_SIMD_CLONES void SweepPseudoBatches(RestingBatches* batches,
-                                                                  std::vector<SolverBody>* bodies,
-                                                                  double position_correction,
-                                                                  double inverse_dt) {
+RBS_SIMD_CLONES void SweepPseudoBatches(RestingBatches* batches, std::vector<SolverBody>* bodies,
+                                        double position_correction, double inverse_dt) {
   SweepAllPseudoBatches(batches, bodies, position_correction, inverse_dt);
 }
 

@@ -142,16 +142,15 @@ TEST(ConcurrencyTest, DeletingAModelWhileItsJointCommandsArriveNeverHangs) {
       // Reported by the test's thread: this one may outlive the test.
       if (!spawned.success || !connected || !deleted.success || !disconnected) {
         const std::lock_guard<std::mutex> lock(progress->mutex);
-        progress->failures.push_back(
-            "cycle " + std::to_string(i) + ": spawn '" + spawned.message + "', connected " +
-            std::to_string(connected) + ", delete '" + deleted.message + "', disconnected " +
-            std::to_string(disconnected));
+        progress->failures.push_back("cycle " + std::to_string(i) + ": spawn '" + spawned.message +
+                                     "', connected " + std::to_string(connected) + ", delete '" +
+                                     deleted.message + "', disconnected " +
+                                     std::to_string(disconnected));
       }
       ++progress->cycles_done;
     }
   }).detach();
-  const bool finished =
-      WaitFor([&] { return progress->cycles_done.load() == kCycles; }, kTimeout);
+  const bool finished = WaitFor([&] { return progress->cycles_done.load() == kCycles; }, kTimeout);
   stop = true;
   commander.join();
   EXPECT_TRUE(finished) << "the node stopped answering after " << progress->cycles_done.load()
