@@ -228,17 +228,29 @@ TEST_F(NodeHostileTest, LongStepLetsOthersInAndIsCancelled) {
     SimClient own_client;
     return own_client.Step(100000);
   });
-  ASSERT_TRUE(WaitFor([&] { return states.Next(1.0).has_value(); }, kTimeout));
+  // Whatever ends this test, the long call ends too: ~set_paused false stops
+  // it, and the future's destructor would otherwise wait for all its steps.
+  struct StopLongStep {
+    std::future<rigid_body_sim::Step::Response>& call;
+    ~StopLongStep() {
+      if (call.valid() && call.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+        SimClient().SetPaused(false);
+      }
+    }
+  } stop_long_step{long_step};
+  const auto sim_time = [&] {
+    const auto message = states.Get();
+    return message ? message->header.stamp.toSec() : start_time;
+  };
+  // The call has started once ~states shows sim time past start_time; a
+  // cancel sent before that finds no call in progress, and is refused.
+  ASSERT_TRUE(WaitFor([&] { return sim_time() > start_time; }, kTimeout));
   const std::uint64_t states_before = states.count();
   std::vector<double> latencies;
   // Watched for 0.5 s, or until ~states shows 40 % of the steps done, so
   // that the call is still running when it is cancelled however fast the
   // machine.
   const double cancel_at = start_time + 0.4 * 100000 / 240.0;
-  const auto sim_time = [&] {
-    const auto message = states.Get();
-    return message ? message->header.stamp.toSec() : start_time;
-  };
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(0.5);
   while (ros::WallTime::now() < end && sim_time() < cancel_at) {
     const ros::WallTime sent = ros::WallTime::now();
