@@ -100,12 +100,8 @@ void SimNode::StepLoop() {
         StepLocked();
       }
       const Clock::time_point now = Clock::now();
-      if (now >= next_publish_) {
-        FillPeriodicLocked(&outbox);
-        const auto publish_period = std::chrono::duration_cast<Clock::duration>(
-            std::chrono::duration<double>(1.0 / live_.publish_rate));
-        next_publish_ = std::max(next_publish_ + publish_period, now);
-      } else if (options_.use_sim_time && now >= next_clock && world_.time() > 0.0) {
+      if (!FillPeriodicIfDueLocked(now, &outbox) && options_.use_sim_time && now >= next_clock &&
+          world_.time() > 0.0) {
         outbox.clock = world_.time();
       }
       if (outbox.clock) next_clock = now + clock_period;

@@ -168,7 +168,13 @@ bool SimNode::OnStep(rigid_body_sim::Step::Request& request,
         ReanchorLocked();
         if (done == request.steps) stopped_by = "done";
       }
-      if (!stopped_by.empty()) FillPeriodicLocked(&outbox);
+      // The call publishes at ~publish_rate itself: between its chunks the
+      // step loop's thread may not win the world's lock.
+      if (!stopped_by.empty()) {
+        FillPeriodicLocked(&outbox);
+      } else {
+        FillPeriodicIfDueLocked(Clock::now(), &outbox);
+      }
       response.sim_time = world_.time();
     }
     Publish(std::move(outbox));

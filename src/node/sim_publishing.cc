@@ -1,6 +1,8 @@
 // What the node publishes: tf, model states, contacts and their markers, and
 // /clock, built under the world lock and sent after it is released.
+#include <algorithm>
 #include <cassert>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -150,6 +152,15 @@ void SimNode::FillPeriodicLocked(Outbox* outbox) {
   outbox->contact_markers = ContactMarkers(contacts, contact_marker_count_, style);
   contact_marker_count_ = static_cast<int>(contacts.size());
   if (options_.use_sim_time && sim_time > 0.0) outbox->clock = sim_time;
+}
+
+bool SimNode::FillPeriodicIfDueLocked(Clock::time_point now, Outbox* outbox) {
+  if (now < next_publish_) return false;
+  FillPeriodicLocked(outbox);
+  const auto publish_period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / live_.publish_rate));
+  next_publish_ = std::max(next_publish_ + publish_period, now);
+  return true;
 }
 
 void SimNode::Publish(Outbox outbox) {

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -73,25 +74,28 @@ class SimClient {
   std::map<std::string, ros::ServiceClient> clients_;
 };
 
-// Keeps the latest message of a topic and counts arrivals.
+// Keeps the latest message of a topic and counts arrivals. The callback
+// owns what it writes: roscpp may still run a callback it had dequeued
+// after the subscriber is destroyed, so the state outlives this object
+// until roscpp lets go of the callback.
 template <typename Message>
 class Latest {
  public:
-  Latest(ros::NodeHandle& node, const std::string& topic) {
-    subscriber_ =
-        node.subscribe<Message>(topic, 100, [this](const boost::shared_ptr<const Message>& m) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          latest_ = *m;
-          ++count_;
+  Latest(ros::NodeHandle& node, const std::string& topic) : state_(std::make_shared<State>()) {
+    subscriber_ = node.subscribe<Message>(
+        topic, 100, [state = state_](const boost::shared_ptr<const Message>& m) {
+          std::lock_guard<std::mutex> lock(state->mutex);
+          state->latest = *m;
+          ++state->count;
         });
   }
   std::optional<Message> Get() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return latest_;
+    std::lock_guard<std::mutex> lock(state_->mutex);
+    return state_->latest;
   }
   std::uint64_t count() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return count_;
+    std::lock_guard<std::mutex> lock(state_->mutex);
+    return state_->count;
   }
   // The first message that arrives after this call, within `timeout` s.
   std::optional<Message> Next(double timeout) const {
@@ -101,10 +105,13 @@ class Latest {
   }
 
  private:
+  struct State {
+    std::mutex mutex;
+    std::optional<Message> latest;  // guarded by mutex
+    std::uint64_t count = 0;        // guarded by mutex
+  };
+  std::shared_ptr<State> state_;
   ros::Subscriber subscriber_;
-  mutable std::mutex mutex_;
-  std::optional<Message> latest_;
-  std::uint64_t count_ = 0;
 };
 
 }  // namespace rigid_body_sim::test

@@ -191,6 +191,9 @@ class SimNode {
   // since they were last built, tf too under sim time (tf2 drops a repeated
   // stamp); under wall time tf goes out every period with a new stamp.
   void FillPeriodicLocked(Outbox* outbox);
+  // FillPeriodicLocked when the publish period has passed, and the next due
+  // time moved on; whether it filled.
+  bool FillPeriodicIfDueLocked(Clock::time_point now, Outbox* outbox);
   void FillTfLocked(const ros::Time& stamp, tf2_msgs::TFMessage* tf) const;
   tf2_msgs::TFMessage ModelTfLocked(const Model& model) const;
   void AppendModelTfLocked(const Model& model, const ros::Time& stamp,
