@@ -1,6 +1,10 @@
 #include "physics/articulation_dynamics.h"
 
+#include <algorithm>
+#include <array>
 #include <cassert>
+#include <cmath>
+#include <vector>
 
 #include <Eigen/Cholesky>
 
@@ -113,6 +117,142 @@ void ComputeKinematics(const ArticulationModel& model, const ArticulationState& 
   }
 }
 
+void JointSpaceInertiaByJacobians(const ArticulationModel& model, const ArticulationKinematics& k,
+                                  Eigen::MatrixXd* mass) {
+  const int n = model.DofCount();
+  mass->setZero(n, n);
+  Eigen::Matrix<double, 6, Eigen::Dynamic> weighted(6, n);
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    const JacobianRows& jacobian = k.jacobian[i];
+    weighted.topRows<3>() = model.links[i].mass * jacobian.topRows<3>();
+    weighted.bottomRows<3>() = k.inertia_world[i] * jacobian.bottomRows<3>();
+    mass->noalias() += jacobian.transpose() * weighted;
+  }
+}
+
+namespace {
+
+// A set of links as one rigid body: its mass, centre of mass and inertia
+// about that centre, world frame.
+struct Composite {
+  double mass = 0.0;            // kg
+  Vec3 com = Vec3::Zero();      // m
+  Mat3 inertia = Mat3::Zero();  // kg m^2
+};
+
+// m ((r.r) 1 - r r^T): the inertia a point mass m at r adds about the origin
+// (the parallel-axis theorem).
+Mat3 ParallelAxis(double mass, const Vec3& r) {
+  return mass * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+}
+
+// Adds `part` to `whole`, both about their own centres of mass.
+void Merge(const Composite& part, Composite* whole) {
+  const double mass = whole->mass + part.mass;
+  if (mass <= 0.0) return;
+  const Vec3 com = (whole->mass * whole->com + part.mass * part.com) / mass;
+  whole->inertia += part.inertia + ParallelAxis(whole->mass, whole->com - com) +
+                    ParallelAxis(part.mass, part.com - com);
+  whole->mass = mass;
+  whole->com = com;
+}
+
+// One unit motion of a whole subtree: its angular velocity, and the
+// velocity of the point x: turning about `axis` through `anchor`, or
+// sliding along `axis`.
+struct UnitMotion {
+  Vec3 axis = Vec3::Zero();
+  Vec3 anchor = Vec3::Zero();
+  bool turns = false;
+  Vec3 AngularVelocity() const { return turns ? axis : Vec3::Zero(); }
+  Vec3 VelocityAt(const Vec3& x) const { return turns ? Vec3(axis.cross(x - anchor)) : axis; }
+};
+
+// u_1^T M u_2 over a composite body that both unit motions move:
+// M v_1(C).v_2(C) + omega_1 . I_C omega_2 (the kinetic energy's bilinear
+// form; the terms linear in the links' offsets from C sum to zero).
+double MotionProduct(const Composite& body, const UnitMotion& first, const UnitMotion& second) {
+  return body.mass * first.VelocityAt(body.com).dot(second.VelocityAt(body.com)) +
+         first.AngularVelocity().dot(body.inertia * second.AngularVelocity());
+}
+
+// The same product with the second motion's momentum made once: linear
+// p = M v_2(C), angular L = I_C omega_2 about C; then u_1^T M u_2 =
+// v_1(C).p + omega_1.L, one cross product per ancestor (Featherstone 2008,
+// section 6.2: the composite body's force f = I^c S_2 projected on S_1).
+struct Momentum {
+  Vec3 linear;   // kg m/s
+  Vec3 angular;  // kg m^2/s, about the composite's centre of mass
+};
+Momentum UnitMomentum(const Composite& body, const UnitMotion& motion) {
+  return {body.mass * motion.VelocityAt(body.com), body.inertia * motion.AngularVelocity()};
+}
+double MotionProduct(const Composite& body, const UnitMotion& first, const Momentum& second) {
+  return first.VelocityAt(body.com).dot(second.linear) +
+         first.AngularVelocity().dot(second.angular);
+}
+
+// Adds value to M(row, column) and, off the diagonal or for two distinct
+// motions of one dof (a mimic and its leader), to M(column, row).
+void AddSymmetric(int row, int column, double value, bool distinct, Eigen::MatrixXd* mass) {
+  (*mass)(row, column) += value;
+  if (row != column || distinct) (*mass)(column, row) += value;
+}
+
+}  // namespace
+
+void JointSpaceInertia(const ArticulationModel& model, const ArticulationKinematics& k,
+                       Eigen::MatrixXd* mass) {
+  const int n = model.DofCount();
+  mass->setZero(n, n);
+  // Each link's subtree as one body, from the leaves in (a joint comes after
+  // its parent link's joint).
+  std::vector<Composite> subtree(model.links.size());
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    subtree[i] = Composite{model.links[i].mass, k.com_world[i], k.inertia_world[i]};
+  }
+  for (std::size_t j = model.joints.size(); j-- > 0;) {
+    const JointDef& def = model.joints[j].def;
+    Merge(subtree[def.child_link], &subtree[def.parent_link]);
+  }
+  const auto joint_motion = [&](std::size_t j) {
+    return UnitMotion{k.joint_axis_world[j], k.joint_anchor_world[j],
+                      model.joints[j].def.type != JointType::kPrismatic};
+  };
+  // A floating base's six dofs move every link: (v_com, omega) of link 0.
+  std::array<UnitMotion, 6> base;
+  for (int axis = 0; axis < 3; ++axis) {
+    base[axis] = UnitMotion{Vec3::Unit(axis), Vec3::Zero(), false};
+    base[3 + axis] = UnitMotion{Vec3::Unit(axis), k.com_world[0], true};
+  }
+  for (int a = 0; a < model.base_dofs; ++a) {
+    for (int b = a; b < model.base_dofs; ++b) {
+      AddSymmetric(a, b, MotionProduct(subtree[0], base[a], base[b]), false, mass);
+    }
+  }
+  // Joint k's motion moves its child's subtree, which every ancestor joint
+  // and the base move too: their entries are products over that subtree.
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    double factor = 1.0;
+    const int dof = model.base_dofs + DrivingDof(model, static_cast<int>(j), &factor);
+    const UnitMotion motion = joint_motion(j);
+    const Composite& moved = subtree[model.joints[j].def.child_link];
+    const Momentum momentum = UnitMomentum(moved, motion);
+    AddSymmetric(dof, dof, factor * factor * MotionProduct(moved, motion, momentum), false, mass);
+    for (int b = 0; b < model.base_dofs; ++b) {
+      AddSymmetric(b, dof, factor * MotionProduct(moved, base[b], momentum), false, mass);
+    }
+    for (int up = model.links[model.joints[j].def.parent_link].parent_joint; up >= 0;
+         up = model.links[model.joints[up].def.parent_link].parent_joint) {
+      double up_factor = 1.0;
+      const int up_dof = model.base_dofs + DrivingDof(model, up, &up_factor);
+      AddSymmetric(up_dof, dof,
+                   up_factor * factor * MotionProduct(moved, joint_motion(up), momentum),
+                   /*distinct=*/true, mass);
+    }
+  }
+}
+
 // The velocity-product accelerations of the links (u' = 0), from the base
 // out (the forward pass of Featherstone's recursive Newton-Euler algorithm,
 // 2008, section 5.3, in world-frame vectors): for a turning joint about s
@@ -147,21 +287,16 @@ void ComputeDynamics(const ArticulationModel& model, const ArticulationState& st
              alpha[c].cross(from_anchor) + w_c.cross(w_c.cross(from_anchor));
     }
   }
-  dynamics->mass.setZero(n, n);
+  JointSpaceInertia(model, k, &dynamics->mass);
   dynamics->force.setZero(n);
   Eigen::Matrix<double, 6, 1> wrench;
   for (std::size_t i = 0; i < link_count; ++i) {
     const ArticulationLink& link = model.links[i];
-    const JacobianRows& jacobian = k.jacobian[i];
     const Mat3& inertia = k.inertia_world[i];
     const Vec3& w = k.angular_velocity[i];
     wrench.head<3>() = link.mass * (gravity - a[i]) + link.force;
     wrench.tail<3>() = link.torque - inertia * alpha[i] - w.cross(inertia * w);
-    dynamics->force.noalias() += jacobian.transpose() * wrench;
-    Eigen::Matrix<double, 6, Eigen::Dynamic> weighted(6, n);
-    weighted.topRows<3>() = link.mass * jacobian.topRows<3>();
-    weighted.bottomRows<3>() = inertia * jacobian.bottomRows<3>();
-    dynamics->mass.noalias() += jacobian.transpose() * weighted;
+    dynamics->force.noalias() += k.jacobian[i].transpose() * wrench;
   }
   for (std::size_t j = 0; j < model.joints.size(); ++j) {
     const ArticulationJoint& joint = model.joints[j];

@@ -4,7 +4,8 @@
 // (docs/design.md, "Articulated bodies").
 //
 // An articulation with no row this step moves freely by RK4 on
-// M(q) u' = Q(q, u), fourth-order exact. One with rows takes the
+// M(q) u' = Q(q, u), fourth-order exact, split into parts where a whole
+// step would gain energy (articulation_free_motion.cc). One with rows takes the
 // velocity-level step of the contact problem: u* = u + dt (M + dt B)^-1 Q
 // (damping B implicit), then impulses u+ = u* + M^-1 J^T lambda with every
 // row's conditions on u+, and q+ = q + dt u+. A row's condition on u+ is one
@@ -197,7 +198,8 @@ void WorldImpl::SolveArticulations(double dt) {
     if (has_rows || touched[i] || DampingIsStiff(model, dynamics.mass, dt)) {
       slot[i] = candidate;
     } else {
-      entry.next = StepFreeMotion(model, entry.state, settings_.gravity, efforts, dt);
+      entry.next = StepFreeMotionBalanced({model, entry.state, settings_.gravity, efforts, dt},
+                                          &entry.free_motion_split);
     }
   }
   AddLinkContactRows(dt, slot, kinematics);

@@ -61,6 +61,7 @@ struct ArticulationEntry {
   ArticulationState state;
   ArticulationState next;
   ServoGains gains;
+  FreeMotionSplit free_motion_split;
   bool in_use = false;
   std::uint32_t generation = 0;
 };

@@ -1,0 +1,145 @@
+// The composite-rigid-body joint-space inertia against the reference sum
+// over the links' Jacobians, on random trees: turning and sliding joints,
+// mimic joints, fixed and floating bases, far from the origin and near it.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "physics/articulation_dynamics.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// Coordinates drawn one statement at a time: the order in which a call's
+// arguments are evaluated is unspecified.
+Vec3 RandomVector(std::mt19937* random, double scale) {
+  std::uniform_real_distribution<double> coordinate(-scale, scale);
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) v[k] = coordinate(*random);
+  return v;
+}
+
+Quat RandomRotation(std::mt19937* random) {
+  std::normal_distribution<double> normal;
+  Eigen::Vector4d q;
+  for (int k = 0; k < 4; ++k) q[k] = normal(*random);
+  return Quat(q.normalized());
+}
+
+// A tree of `links` links, each joint's parent drawn from the links before
+// its child; every fourth joint past the first mimics an earlier joint
+// that mimics none.
+ArticulationModel RandomTree(int links, bool floating, std::mt19937* random) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  ArticulationModel model;
+  model.fixed_base = !floating;
+  model.base_dofs = floating ? 6 : 0;
+  for (int i = 0; i < links; ++i) {
+    ArticulationLink link;
+    link.mass = 0.1 + 5.0 * unit(*random);
+    link.com_link = RandomVector(random, 0.3);
+    const Vec3 moments = Vec3(0.01, 0.01, 0.01) + RandomVector(random, 0.005).cwiseAbs();
+    const Mat3 rotation = RandomRotation(random).toRotationMatrix();
+    link.inertia_link = rotation * moments.asDiagonal() * rotation.transpose();
+    model.links.push_back(link);
+  }
+  std::vector<int> leaders;
+  for (int child = 1; child < links; ++child) {
+    ArticulationJoint joint;
+    joint.def.parent_link = std::uniform_int_distribution<int>(0, child - 1)(*random);
+    joint.def.child_link = child;
+    joint.def.type = unit(*random) < 0.25 ? JointType::kPrismatic : JointType::kRevolute;
+    joint.def.parent_from_joint = Pose{RandomVector(random, 0.5), RandomRotation(random)};
+    joint.def.axis = RandomVector(random, 1.0).normalized();
+    const int index = static_cast<int>(model.joints.size());
+    if (index > 0 && index % 4 == 0) {
+      joint.def.mimic_joint = leaders[std::uniform_int_distribution<std::size_t>(
+          0, leaders.size() - 1)(*random)];
+      joint.def.mimic_multiplier = -2.0 + 4.0 * unit(*random);
+    } else {
+      joint.dof = model.joint_dofs++;
+      leaders.push_back(index);
+    }
+    model.links[child].parent_joint = index;
+    model.joints.push_back(joint);
+  }
+  return model;
+}
+
+ArticulationState RandomState(const ArticulationModel& model, const Vec3& where,
+                              std::mt19937* random) {
+  ArticulationState state;
+  state.base_com = where;
+  state.base_rotation = RandomRotation(random);
+  std::uniform_real_distribution<double> coordinate(-2.0, 2.0);
+  state.q.resize(model.joint_dofs);
+  for (Eigen::Index k = 0; k < state.q.size(); ++k) state.q[k] = coordinate(*random);
+  state.u = Eigen::VectorXd::Zero(model.DofCount());
+  return state;
+}
+
+// Largest |difference| of the two, over the largest |entry|.
+double RelativeDifference(const Eigen::MatrixXd& fast, const Eigen::MatrixXd& reference) {
+  return (fast - reference).cwiseAbs().maxCoeff() / reference.cwiseAbs().maxCoeff();
+}
+
+TEST(JointSpaceInertiaTest, CompositeBodiesMatchTheSumOverJacobiansOnRandomTrees) {
+  std::mt19937 random(20261127);
+  int compared = 0;
+  for (const bool floating : {false, true}) {
+    for (const int links : {2, 3, 7, 16, 31}) {
+      for (const Vec3& where : {Vec3(0.0, 0.0, 1.0), Vec3(150.0, -80.0, 20.0)}) {
+        const ArticulationModel model = RandomTree(links, floating, &random);
+        const ArticulationState state = RandomState(model, where, &random);
+        ArticulationKinematics kinematics;
+        ComputeKinematics(model, state, &kinematics);
+        Eigen::MatrixXd fast;
+        Eigen::MatrixXd reference;
+        JointSpaceInertia(model, kinematics, &fast);
+        JointSpaceInertiaByJacobians(model, kinematics, &reference);
+        ASSERT_EQ(fast.rows(), model.DofCount());
+        ASSERT_EQ(fast.cols(), model.DofCount());
+        // Both are sums of the same terms in another order: rounding apart.
+        EXPECT_LT(RelativeDifference(fast, reference), 1e-12)
+            << links << " links, floating " << floating << ", at " << where.transpose();
+        EXPECT_LT((fast - fast.transpose()).cwiseAbs().maxCoeff(), 1e-15 * fast.norm());
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 20);
+}
+
+// A single link turning about an axis through its hinge: M = I_axis + m d^2,
+// the parallel-axis theorem, with d the centre's distance from the axis.
+TEST(JointSpaceInertiaTest, OneHingeGivesTheParallelAxisTheorem) {
+  ArticulationModel model;
+  ArticulationLink base;
+  base.mass = 1.0;
+  ArticulationLink bob;
+  bob.mass = 2.0;
+  bob.com_link = Vec3(0.0, 0.0, -0.5);
+  bob.inertia_link = Vec3(0.03, 0.04, 0.05).asDiagonal();
+  bob.parent_joint = 0;
+  model.links = {base, bob};
+  ArticulationJoint hinge;
+  hinge.def.parent_link = 0;
+  hinge.def.child_link = 1;
+  hinge.def.axis = Vec3::UnitY();
+  hinge.dof = 0;
+  model.joints = {hinge};
+  model.joint_dofs = 1;
+  ArticulationState state;
+  state.q = Eigen::VectorXd::Constant(1, 0.3);
+  state.u = Eigen::VectorXd::Zero(1);
+  ArticulationKinematics kinematics;
+  ComputeKinematics(model, state, &kinematics);
+  Eigen::MatrixXd mass;
+  JointSpaceInertia(model, kinematics, &mass);
+  EXPECT_NEAR(mass(0, 0), 0.04 + 2.0 * 0.5 * 0.5, 1e-15);
+}
+
+}  // namespace
+}  // namespace rigid_body_sim::physics
