@@ -168,18 +168,13 @@ struct UnitMotion {
   Vec3 VelocityAt(const Vec3& x) const { return turns ? Vec3(axis.cross(x - anchor)) : axis; }
 };
 
-// u_1^T M u_2 over a composite body that both unit motions move:
+// u_1^T M u_2 over a composite body that both unit motions move is
 // M v_1(C).v_2(C) + omega_1 . I_C omega_2 (the kinetic energy's bilinear
-// form; the terms linear in the links' offsets from C sum to zero).
-double MotionProduct(const Composite& body, const UnitMotion& first, const UnitMotion& second) {
-  return body.mass * first.VelocityAt(body.com).dot(second.VelocityAt(body.com)) +
-         first.AngularVelocity().dot(body.inertia * second.AngularVelocity());
-}
-
-// The same product with the second motion's momentum made once: linear
-// p = M v_2(C), angular L = I_C omega_2 about C; then u_1^T M u_2 =
-// v_1(C).p + omega_1.L, one cross product per ancestor (Featherstone 2008,
-// section 6.2: the composite body's force f = I^c S_2 projected on S_1).
+// form; the terms linear in the links' offsets from C sum to zero). With
+// the second motion's momentum made once, linear p = M v_2(C) and angular
+// L = I_C omega_2 about C, it is v_1(C).p + omega_1.L: one cross product per
+// ancestor (Featherstone 2008, section 6.2: the composite body's force
+// f = I^c S_2 projected on S_1).
 struct Momentum {
   Vec3 linear;   // kg m/s
   Vec3 angular;  // kg m^2/s, about the composite's centre of mass
@@ -227,7 +222,8 @@ void JointSpaceInertia(const ArticulationModel& model, const ArticulationKinemat
   }
   for (int a = 0; a < model.base_dofs; ++a) {
     for (int b = a; b < model.base_dofs; ++b) {
-      AddSymmetric(a, b, MotionProduct(subtree[0], base[a], base[b]), false, mass);
+      AddSymmetric(a, b, MotionProduct(subtree[0], base[a], UnitMomentum(subtree[0], base[b])),
+                   false, mass);
     }
   }
   // Joint k's motion moves its child's subtree, which every ancestor joint
