@@ -111,7 +111,7 @@ SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-om
 SANITIZE_TARGETS := rigid_body_sim_node rigid_body_sim_mesh_helper rigid_body_sim_generate_messages \
   rigid_body_sim_gencfg node_conversion_test \
   node_services_test node_falling_box_test node_contacts_test node_concurrency_test \
-  node_hostile_test node_time_stamps_test
+  node_hostile_test node_hostile_joints_test node_time_stamps_test
 sanitize: test-sanitize
 	$(MAKE) --no-print-directory ws-links WS=$(WS_ASAN)
 	catkin_make -C $(WS_ASAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -137,7 +137,8 @@ sanitize: test-sanitize
 # build/fuzz/artifacts.
 FUZZ_BUILD := $(ROOT)/build/fuzz
 FUZZ_SECONDS ?= 600
-FUZZERS := urdf_loader_fuzzer mesh_parser_fuzzer request_validation_fuzzer
+FUZZERS := urdf_loader_fuzzer mesh_parser_fuzzer request_validation_fuzzer joint_requests_fuzzer \
+  decomposition_cache_fuzzer
 fuzz: deps
 	cmake -S $(ROOT) -B $(FUZZ_BUILD) -DRBS_CORE_ONLY=ON -DRBS_FUZZ=ON -DCMAKE_BUILD_TYPE=None \
 	  -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \

@@ -10,9 +10,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -32,9 +34,6 @@ using physics::Result;
 using physics::Status;
 using physics::Vec3;
 
-// A hull of 1e5 vertices is about 10 MB of text; more is not a hull.
-constexpr std::size_t kMaxReplyBytes = std::size_t{64} << 20;
-
 std::string Quoted(const std::string& text) { return "'" + text + "'"; }
 
 // The text after "error " in a helper's refusal.
@@ -44,6 +43,14 @@ std::string RefusalText(const std::string& reply) {
 }
 
 }  // namespace
+
+std::uint64_t MaxReplyBytes(const MeshProcessLimits& limits) {
+  const std::uint64_t triangles =
+      std::min<std::uint64_t>(limits.max_triangles, physics::CollisionMesh::kMaxTriangles);
+  const std::uint64_t header = 64;
+  return std::max(kMaxHullReplyBytes,
+                  header + triangles * (3 * kBytesPerVertex + kBytesPerTriangle));
+}
 
 namespace internal {
 
@@ -107,7 +114,7 @@ std::string DescribeDeath(int status, bool timed_out, const MeshProcessLimits& l
 struct HelperRun {
   int status = 0;
   bool timed_out = false;
-  bool oversized = false;  // the reply passed kMaxReplyBytes
+  bool oversized = false;  // the reply passed MaxReplyBytes
   std::string reply;
 };
 
@@ -149,6 +156,7 @@ Result<HelperRun> RunHelper(const std::vector<std::string>& arguments,
   }
 
   HelperRun run;
+  const std::uint64_t max_reply_bytes = MaxReplyBytes(limits);
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration<double>(2.0 * limits.cpu_seconds + 1.0);
   char buffer[65536];
@@ -157,7 +165,7 @@ Result<HelperRun> RunHelper(const std::vector<std::string>& arguments,
     // none left and the helper was killed before its deadline.
     const auto left =
         std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0 || run.reply.size() > kMaxReplyBytes) {
+    if (left.count() <= 0 || run.reply.size() > max_reply_bytes) {
       ::kill(pid, SIGKILL);
       run.timed_out = left.count() <= 0;
       run.oversized = !run.timed_out;
@@ -205,15 +213,23 @@ std::string FormatErrorReply(const std::string& message) {
 }
 
 std::string FormatTrianglesReply(const physics::TriangleMesh& mesh) {
-  std::string reply = "triangles " + std::to_string(mesh.vertices.size()) + " " +
+  // Binary after the header line: a 2M-triangle terrain is some 50 MB this
+  // way, and read by copying instead of parsing 3M hexadecimal floats.
+  std::string reply = std::string(kBinaryTrianglesWord) + " " +
+                      std::to_string(mesh.vertices.size()) + " " +
                       std::to_string(mesh.triangles.size()) + "\n";
+  const std::size_t header = reply.size();
+  reply.resize(header + kBytesPerVertex * mesh.vertices.size() +
+               kBytesPerTriangle * mesh.triangles.size());
+  char* out = reply.data() + header;
   for (const Vec3& vertex : mesh.vertices) {
-    reply += "v " + HexFloat(vertex.x()) + " " + HexFloat(vertex.y()) + " " + HexFloat(vertex.z()) +
-             "\n";
+    for (int k = 0; k < 3; ++k, out += sizeof(double)) std::memcpy(out, &vertex[k], sizeof(double));
   }
   for (const Eigen::Vector3i& triangle : mesh.triangles) {
-    reply += "t " + std::to_string(triangle[0]) + " " + std::to_string(triangle[1]) + " " +
-             std::to_string(triangle[2]) + "\n";
+    for (int k = 0; k < 3; ++k, out += sizeof(std::int32_t)) {
+      const std::int32_t index = triangle[k];
+      std::memcpy(out, &index, sizeof(index));
+    }
   }
   return reply;
 }
@@ -240,6 +256,44 @@ std::string ReadVertexLine(std::istream& in, Vec3* vertex) {
 
 }  // namespace
 
+namespace {
+
+// The binary body of a triangles reply from byte `start` on: V vertices of
+// three little-endian doubles, then T triangles of three int32 indices;
+// exactly that many bytes, finite coordinates, indices below V.
+Result<physics::TriangleMesh> ParseBinaryTriangles(const std::string& reply, std::size_t start,
+                                                   std::size_t vertex_count,
+                                                   std::size_t triangle_count) {
+  using Out = Result<physics::TriangleMesh>;
+  const std::size_t expected = kBytesPerVertex * vertex_count + kBytesPerTriangle * triangle_count;
+  if (reply.size() - start != expected) {
+    return Out::Error("mesh helper reply: " + std::to_string(reply.size() - start) +
+                      " bytes of vertices and triangles, expected " + std::to_string(expected));
+  }
+  const char* in = reply.data() + start;
+  physics::TriangleMesh mesh;
+  mesh.vertices.resize(vertex_count);
+  for (Vec3& vertex : mesh.vertices) {
+    for (int k = 0; k < 3; ++k, in += sizeof(double)) std::memcpy(&vertex[k], in, sizeof(double));
+    if (!vertex.allFinite()) return Out::Error("mesh helper reply: a vertex is not finite");
+  }
+  mesh.triangles.resize(triangle_count);
+  for (Eigen::Vector3i& triangle : mesh.triangles) {
+    for (int k = 0; k < 3; ++k, in += sizeof(std::int32_t)) {
+      std::int32_t index = -1;
+      std::memcpy(&index, in, sizeof(index));
+      if (index < 0 || static_cast<std::size_t>(index) >= vertex_count) {
+        return Out::Error("mesh helper reply: a triangle has a vertex index outside [0, " +
+                          std::to_string(vertex_count) + ")");
+      }
+      triangle[k] = index;
+    }
+  }
+  return mesh;
+}
+
+}  // namespace
+
 // Reads "triangles V T", V vertex lines of hexadecimal floats and T
 // triangle lines of indices below V; counts within CollisionMesh's limit.
 Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
@@ -250,7 +304,8 @@ Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
   std::string word;
   long vertex_count = 0;
   long triangle_count = 0;
-  if (!(in >> word >> vertex_count >> triangle_count) || word != "triangles") {
+  if (!(in >> word >> vertex_count >> triangle_count) ||
+      (word != "triangles" && word != kBinaryTrianglesWord)) {
     return fail("no 'triangles <vertices> <triangles>' header");
   }
   const long most = static_cast<long>(physics::CollisionMesh::kMaxTriangles);
@@ -258,6 +313,12 @@ Result<physics::TriangleMesh> ParseTrianglesReply(const std::string& reply) {
     return fail(std::to_string(vertex_count) + " vertices and " + std::to_string(triangle_count) +
                 " triangles are outside [3, " + std::to_string(3 * most) + "] and [1, " +
                 std::to_string(most) + "]");
+  }
+  if (word == kBinaryTrianglesWord) {
+    const std::size_t end_of_header = reply.find('\n');
+    if (end_of_header == std::string::npos) return fail("the header line has no end");
+    return ParseBinaryTriangles(reply, end_of_header + 1, static_cast<std::size_t>(vertex_count),
+                                static_cast<std::size_t>(triangle_count));
   }
   physics::TriangleMesh mesh;
   mesh.vertices.resize(static_cast<std::size_t>(vertex_count));
@@ -329,7 +390,7 @@ Result<ConvexPolyhedron> internal::ParseHull(std::istream& in, int max_vertices)
 // is none: the file's own problem (checked before any process starts), the
 // helper's refusal (with the limits, since an allocation that failed at the
 // memory limit can look like a malformed file to the importer), its death,
-// or a reply past kMaxReplyBytes.
+// or a reply past MaxReplyBytes.
 Result<std::string> internal::HelperReply(const std::vector<std::string>& arguments,
                                           const std::string& path,
                                           const MeshProcessLimits& limits) {
@@ -339,9 +400,10 @@ Result<std::string> internal::HelperReply(const std::vector<std::string>& argume
   Result<HelperRun> run = RunHelper(arguments, limits);
   if (!run.ok()) return run.status();
   if (run->oversized) {
-    return Result<std::string>::Error("mesh " + Quoted(path) + ": the mesh helper's reply " +
-                                      "passed " + std::to_string(kMaxReplyBytes) +
-                                      " bytes and it was killed");
+    return Result<std::string>::Error(
+        "mesh " + Quoted(path) + ": the mesh helper's reply " + "passed " +
+        std::to_string(MaxReplyBytes(limits)) + " bytes (what max_triangles " +
+        std::to_string(limits.max_triangles) + " allows) and it was killed");
   }
   const bool exited = WIFEXITED(run->status);
   if (!run->timed_out && exited && run->reply.rfind("error ", 0) == 0) {
@@ -399,6 +461,7 @@ Result<physics::TriangleMesh> LoadMeshTrianglesOutOfProcess(const std::string& p
                                               HexFloat(scale.x()),
                                               HexFloat(scale.y()),
                                               HexFloat(scale.z()),
+                                              std::to_string(limits.max_triangles),
                                               std::to_string(limits.memory_bytes),
                                               HexFloat(limits.cpu_seconds),
                                               std::to_string(limits.max_file_bytes)};

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -37,9 +39,23 @@ Result<std::vector<double>> Numbers(const TiXmlElement& element, const char* nam
     char* end = nullptr;
     errno = 0;
     const double value = std::strtod(cursor, &end);
+    const bool out_of_range = errno == ERANGE;
     const std::string field = where + " " + name + "=" + Quoted(text);
     if (end == cursor) return Result<std::vector<double>>::Error(field + " is not a number");
-    if (!std::isfinite(value) || errno == ERANGE) {
+    const std::string number(cursor, static_cast<std::size_t>(end - cursor));
+    // strtod flags a result too small for a normal double (a subnormal, or
+    // 0) as ERANGE too: it is finite, but not the number written.
+    if (out_of_range && std::abs(value) <= DBL_MIN) {
+      return Result<std::vector<double>>::Error(
+          field + ": " + number + " underflows (its magnitude is below " + FormatNumber(DBL_MIN) +
+          ", the smallest normal double)");
+    }
+    if (out_of_range) {
+      return Result<std::vector<double>>::Error(field + " is not a finite number: " + number +
+                                                " overflows (its magnitude is above " +
+                                                FormatNumber(DBL_MAX) + ", the largest double)");
+    }
+    if (!std::isfinite(value)) {
       return Result<std::vector<double>>::Error(field + " is not a finite number");
     }
     numbers.push_back(value);
@@ -83,37 +99,94 @@ Status CheckOrigin(const TiXmlElement& parent, const std::string& where) {
   return rpy.status();
 }
 
+// The bound of joint numbers that need only be finite: an effort,
+// velocity or damping this large is no limit in effect, and the loader
+// reads neither <safety_controller> nor <calibration>.
+constexpr double kLargestJointNumber = 1e300;
+
+// Whether `text` begins, after blanks, with something strtod reads as a
+// number.
+bool StartsWithNumber(const char* text) {
+  char* end = nullptr;
+  std::strtod(text, &end);
+  return end != text;
+}
+
+// One number of a joint element and its allowed range.
+struct JointNumber {
+  const char* element;
+  const char* attribute;
+  double low;
+  double high;
+};
+
+// The numbers of a joint's <limit>, <dynamics>, <mimic>,
+// <safety_controller> and <calibration>, each within its range:
+// - <limit> effort and velocity >= 0 (0, as many descriptions write it, is
+//   no limit); lower and upper finite, and for a revolute or prismatic
+//   (`bounded`) joint reaching within kMaxJointPosition: it starts at 0
+//   brought within them, and the node sets no position beyond. A bound
+//   beyond it outwards is kept (descriptions for Gazebo write +/-1e16 for
+//   "unlimited"), and lower > upper is read as no limit (Bullet's habit;
+//   see JointMotion);
+// - <dynamics> damping and friction >= 0;
+// - <mimic> |multiplier| <= kMaxMimicMultiplier, |offset| <=
+//   kMaxJointPosition (CheckMimicJoints checks them with the leader's
+//   limits);
+// - <safety_controller> and <calibration> finite, k_position and
+//   k_velocity >= 0. A calibration that is not a number at all is left to
+//   urdfdom, which refuses it by name.
+Status CheckJointNumbers(const TiXmlElement& joint, const std::string& where, bool bounded) {
+  constexpr double kLargest = kLargestJointNumber;
+  const JointNumber numbers[] = {
+      {"limit", "effort", 0.0, kLargest},
+      {"limit", "velocity", 0.0, kLargest},
+      {"limit", "lower", -kLargest, bounded ? kMaxJointPosition : kLargest},
+      {"limit", "upper", bounded ? -kMaxJointPosition : -kLargest, kLargest},
+      {"dynamics", "damping", 0.0, kLargest},
+      {"dynamics", "friction", 0.0, kLargest},
+      {"mimic", "multiplier", -kMaxMimicMultiplier, kMaxMimicMultiplier},
+      {"mimic", "offset", -kMaxJointPosition, kMaxJointPosition},
+      {"safety_controller", "soft_lower_limit", -kLargest, kLargest},
+      {"safety_controller", "soft_upper_limit", -kLargest, kLargest},
+      {"safety_controller", "k_position", 0.0, kLargest},
+      {"safety_controller", "k_velocity", 0.0, kLargest},
+      {"calibration", "rising", -kLargest, kLargest},
+      {"calibration", "falling", -kLargest, kLargest}};
+  for (const JointNumber& number : numbers) {
+    const TiXmlElement* element = joint.FirstChildElement(number.element);
+    if (element == nullptr) continue;
+    const char* text = element->Attribute(number.attribute);
+    if (text != nullptr && std::string(number.element) == "calibration" &&
+        !StartsWithNumber(text)) {
+      continue;
+    }
+    Result<std::vector<double>> value =
+        NumbersIn(*element, number.attribute, where + " <" + number.element + ">", 1, number.low,
+                  number.high, false);
+    if (!value.ok()) return value.status();
+  }
+  return Status::Ok();
+}
+
 // A movable joint's <axis xyz> finite and not the zero vector (urdfdom keeps
 // a zero axis, about which the joint could not move; a fixed joint's is
-// never used); its <limit> effort and
-// velocity >= 0 (0, as many descriptions write it, is no limit) and its
-// lower and upper finite; its <dynamics> damping and friction >= 0.
+// never used); then the numbers of its other elements, each within its
+// range (CheckJointNumbers).
 Status CheckJointElements(const TiXmlElement& joint, const std::string& where) {
-  constexpr double kLargest = 1e300;
   const char* type = joint.Attribute("type");
   const std::string kind = type == nullptr ? "" : type;
   const bool movable = kind == "revolute" || kind == "continuous" || kind == "prismatic";
   if (const TiXmlElement* axis = joint.FirstChildElement("axis"); axis != nullptr && movable) {
     const std::string at = where + " <axis>";
-    Result<std::vector<double>> xyz = NumbersIn(*axis, "xyz", at, 3, -kLargest, kLargest, false);
+    Result<std::vector<double>> xyz =
+        NumbersIn(*axis, "xyz", at, 3, -kLargestJointNumber, kLargestJointNumber, false);
     if (!xyz.ok()) return xyz.status();
     if (!xyz->empty() && std::all_of(xyz->begin(), xyz->end(), [](double v) { return v == 0.0; })) {
       return Status::Error(at + " xyz='0 0 0' is the zero vector; give the joint's direction");
     }
   }
-  const std::pair<const char*, std::pair<const char*, double>> ranges[] = {
-      {"limit", {"effort", 0.0}},      {"limit", {"velocity", 0.0}},
-      {"limit", {"lower", -kLargest}}, {"limit", {"upper", -kLargest}},
-      {"dynamics", {"damping", 0.0}},  {"dynamics", {"friction", 0.0}}};
-  for (const auto& [element_name, attribute] : ranges) {
-    const TiXmlElement* element = joint.FirstChildElement(element_name);
-    if (element == nullptr) continue;
-    Result<std::vector<double>> value =
-        NumbersIn(*element, attribute.first, where + " <" + element_name + ">", 1, attribute.second,
-                  kLargest, false);
-    if (!value.ok()) return value.status();
-  }
-  return Status::Ok();
+  return CheckJointNumbers(joint, where, kind == "revolute" || kind == "prismatic");
 }
 
 Status CheckGeometry(const TiXmlElement& geometry, const std::string& where,
@@ -321,6 +394,29 @@ bool IsStaticDocument(const TiXmlElement& robot, const UrdfLoadOptions& options)
   return false;
 }
 
+// The movable joints of a model that will move as an articulation (not
+// spawned static, not welded, not all massless): its step costs about n^3
+// in them (docs/limits.md), so their count is a limit of its own.
+Status CheckMovableJointCount(const TiXmlElement& robot, const UrdfLoadOptions& options) {
+  if (!options.articulate || options.spawn_static || options.weld_movable_joints ||
+      EveryLinkIsMassless(robot)) {
+    return Status::Ok();
+  }
+  int movable = 0;
+  for (const TiXmlElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const char* type = joint->Attribute("type");
+    const std::string kind = type == nullptr ? "" : type;
+    if (kind == "revolute" || kind == "continuous" || kind == "prismatic") ++movable;
+  }
+  if (movable > options.max_joints) {
+    return Status::Error("the model has " + std::to_string(movable) +
+                         " movable joints, above max_joints_per_model " +
+                         std::to_string(options.max_joints));
+  }
+  return Status::Ok();
+}
+
 Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& options) {
   const double max_aspect_ratio = MaxAspectRatio(IsStaticDocument(robot, options));
   int links = 0;
@@ -332,6 +428,7 @@ Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& optio
     return Status::Error("the model has " + std::to_string(links) +
                          " links, above max_links_per_model " + std::to_string(options.max_links));
   }
+  if (Status status = CheckMovableJointCount(robot, options); !status.ok()) return status;
   for (const TiXmlElement* link = robot.FirstChildElement("link"); link != nullptr;
        link = link->NextSiblingElement("link")) {
     if (Status status = CheckLink(*link, max_aspect_ratio); !status.ok()) return status;
@@ -345,6 +442,92 @@ Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& optio
     }
   }
   return CheckJointTree(robot);
+}
+
+namespace {
+
+bool IsMovable(int type) {
+  return type == urdf::Joint::REVOLUTE || type == urdf::Joint::CONTINUOUS ||
+         type == urdf::Joint::PRISMATIC;
+}
+
+const char* PositionUnit(int type) { return type == urdf::Joint::PRISMATIC ? "m" : "rad"; }
+
+// The leader's position range as its mimics see it: its <limit> lower and
+// upper, a side without one infinite (continuous, lower > upper, or a bound
+// beyond kMaxJointPosition, which only the simulation, never a request,
+// can drive the joint past).
+std::pair<double, double> LeaderRange(const urdf::Joint& leader) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  if (leader.type == urdf::Joint::CONTINUOUS || leader.limits == nullptr ||
+      leader.limits->lower > leader.limits->upper) {
+    return {-kInfinity, kInfinity};
+  }
+  const double lower = leader.limits->lower;
+  const double upper = leader.limits->upper;
+  return {lower >= -kMaxJointPosition ? lower : -kInfinity,
+          upper <= kMaxJointPosition ? upper : kInfinity};
+}
+
+// A mimic's position over its leader's range and its speed at its leader's
+// velocity limit; with a leader unbounded on a side only its multiplier and
+// offset are bounded (CheckJointNumbers).
+Status CheckMimicWithLeader(const urdf::Joint& joint, const urdf::Joint& leader) {
+  const double multiplier = joint.mimic->multiplier;
+  const double offset = joint.mimic->offset;
+  const std::string where = "joint " + Quoted(joint.name) + " <mimic>";
+  const std::string unit = PositionUnit(joint.type);
+  const auto [lower, upper] = LeaderRange(leader);
+  if (multiplier != 0.0 && std::isfinite(lower) && std::isfinite(upper)) {
+    const double from = multiplier * lower + offset;
+    const double to = multiplier * upper + offset;
+    if (!(std::max(std::abs(from), std::abs(to)) <= kMaxJointPosition)) {
+      return Status::Error(
+          where + " position range " + Range(std::min(from, to), std::max(from, to)) + " " + unit +
+          " (multiplier " + FormatNumber(multiplier) + " times leader " + Quoted(leader.name) +
+          " limits " + Range(lower, upper) + ", plus offset " + FormatNumber(offset) +
+          ") is outside the allowed range " + Range(-kMaxJointPosition, kMaxJointPosition));
+    }
+  }
+  // A stated velocity limit of 0 is none (JointMotion), and so is the mimic's.
+  if (leader.limits != nullptr && leader.limits->velocity > 0.0) {
+    const double speed = std::abs(multiplier) * leader.limits->velocity;
+    if (!(speed <= kMaxJointSpeed)) {
+      return Status::Error(where + " velocity bound " + FormatNumber(speed) + " " + unit +
+                           "/s (|multiplier| " + FormatNumber(std::abs(multiplier)) +
+                           " times leader " + Quoted(leader.name) + " velocity limit " +
+                           FormatNumber(leader.limits->velocity) +
+                           ") is outside the allowed range " + Range(0.0, kMaxJointSpeed));
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status CheckMimicJoints(const urdf::ModelInterface& model) {
+  // Leader: 1 + the sum of its mimics' squared multipliers, the factor on
+  // its effort limit when it and each mimic exert it (physics::MakeModel).
+  std::map<std::string, double> effort_scale;
+  for (const auto& [name, joint] : model.joints_) {
+    if (joint->mimic == nullptr || !IsMovable(joint->type)) continue;
+    const auto found = model.joints_.find(joint->mimic->joint_name);
+    if (found == model.joints_.end()) continue;  // CheckJoints names it
+    const urdf::Joint& leader = *found->second;
+    if (Status status = CheckMimicWithLeader(*joint, leader); !status.ok()) return status;
+    double& scale = effort_scale.emplace(leader.name, 1.0).first->second;
+    scale += joint->mimic->multiplier * joint->mimic->multiplier;
+    // An effort limit of 0 is none, and infinite by design.
+    const double effort = leader.limits == nullptr ? 0.0 : leader.limits->effort;
+    if (effort > 0.0 && !std::isfinite(scale * effort)) {
+      return Status::Error(
+          "joint " + Quoted(name) + " <mimic> multiplier " +
+          FormatNumber(joint->mimic->multiplier) + " raises the effort scale of leader " +
+          Quoted(leader.name) + " (1 + its mimics' squared multipliers) to " + FormatNumber(scale) +
+          ", and its effort limit " + FormatNumber(effort) + " times that is not finite");
+    }
+  }
+  return Status::Ok();
 }
 
 }  // namespace rigid_body_sim::io

@@ -7,6 +7,7 @@
 #define RIGID_BODY_SIM_IO_URDF_CHECKS_H_
 
 #include <tinyxml.h>
+#include <urdf_model/model.h>
 
 #include "rigid_body_sim/io/urdf_loader.h"
 #include "rigid_body_sim/physics/result.h"
@@ -16,9 +17,20 @@ namespace rigid_body_sim::io {
 
 // Checks the link count against options.max_links, every collision
 // geometry's sizes against kMinShapeSize, kMaxShapeSize and
-// MaxAspectRatio, and every <origin>, <mass> and <inertia> of links
-// and joints for finite numbers within kMaxShapeSize.
+// MaxAspectRatio, every <origin>, <mass> and <inertia> of links and joints
+// for finite numbers within kMaxShapeSize, and every number of a joint's
+// <axis>, <limit>, <dynamics>, <mimic>, <safety_controller> and
+// <calibration> against its range. A number whose magnitude underflows a
+// normal double (1e-320) is refused as well: it is not the number written.
 physics::Status CheckUrdfDocument(const TiXmlElement& robot, const UrdfLoadOptions& options);
+
+// Every mimic joint of a movable type with its leader (urdfdom's reading):
+// multiplier * [leader lower, upper] + offset within kMaxJointPosition when
+// the leader is limited on both sides within it, |multiplier| * the
+// leader's velocity limit within kMaxJointSpeed, and the leader's effort
+// limit times its effort scale (1 + the sum of its mimics' squared
+// multipliers) finite. Leaders are CheckJoints' to name (urdf_loader.cc).
+physics::Status CheckMimicJoints(const urdf::ModelInterface& model);
 
 // The extents of a shape's bounding box (m), within [kMinShapeSize,
 // kMaxShapeSize] and with largest / smallest <= max_aspect_ratio; `what`

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdlib>
+
+#include "rigid_body_sim/io/urdf_loader.h"
 
 namespace rigid_body_sim::io {
 
@@ -42,7 +46,8 @@ const char* JointTypeName(int type) {
 }
 
 // Friction coefficients from <gazebo reference="LINK"><mu1>, which urdfdom
-// does not read, so the XML is walked directly.
+// does not read, so the XML is walked directly: each a finite number >= 0,
+// one above kMaxFrictionCoefficient read as it (see urdf_loader.h).
 Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& robot) {
   std::map<std::string, double> friction;
   for (const TiXmlElement* gazebo = robot.FirstChildElement("gazebo"); gazebo != nullptr;
@@ -58,13 +63,21 @@ Result<std::map<std::string, double>> ReadGazeboFriction(const TiXmlElement& rob
         return Result<std::map<std::string, double>>::Error(where + " is empty");
       }
       char* end = nullptr;
+      errno = 0;
       const double value = std::strtod(text, &end);
+      const bool out_of_range = errno == ERANGE;
       while (end != nullptr && std::isspace(static_cast<unsigned char>(*end))) ++end;
       if (end == text || *end != '\0' || !std::isfinite(value) || value < 0.0) {
         return Result<std::map<std::string, double>>::Error(where + " value " + Quoted(text) +
                                                             " is not a finite non-negative number");
       }
-      friction[reference] = value;
+      // strtod's ERANGE on a finite result: too small for a normal double.
+      if (out_of_range) {
+        return Result<std::map<std::string, double>>::Error(
+            where + " value " + Quoted(text) + " underflows (its magnitude is below " +
+            FormatNumber(DBL_MIN) + ", the smallest normal double)");
+      }
+      friction[reference] = std::min(value, kMaxFrictionCoefficient);
     }
   }
   return friction;

@@ -167,6 +167,8 @@ class ModelBuilder {
     std::vector<MassProperties> parts_in_root;
     const Status status = AddLinks(*body_root, &loaded, &parts_in_root);
     if (!status.ok()) return status;
+    loaded.warnings.insert(loaded.warnings.end(), meshes_.warnings().begin(),
+                           meshes_.warnings().end());
     if (loaded.shapes.empty()) {
       return Result<LoadedModel>::Error("model " + Quoted(loaded.name) +
                                         " has no <collision> elements");
@@ -182,9 +184,11 @@ class ModelBuilder {
     return loaded;
   }
 
-  // Refuses joints that cannot be welded, and joint positions that name no
-  // weldable joint or lie outside its limits.
-  Status CheckJoints(const urdf::ModelInterface& model) const {
+  // Refuses joints that cannot be welded, joint positions that name no
+  // weldable joint or lie outside its limits or kMaxJointPosition, and
+  // mimic joints that would move beyond kMaxJointPosition or
+  // kMaxJointSpeed (CheckMimicJoints); then sets the initial positions.
+  Status CheckJoints(const urdf::ModelInterface& model) {
     for (const auto& [name, joint] : model.joints_) {
       if (joint->type == urdf::Joint::FIXED) continue;
       if (joint->type == urdf::Joint::FLOATING && joint->parent_link_name == kWorldLink) continue;
@@ -222,31 +226,66 @@ class ModelBuilder {
       if (!std::isfinite(position)) {
         return Status::Error("joint " + Quoted(name) + " position is not finite");
       }
+      const char* unit = joint.type == urdf::Joint::PRISMATIC ? " m" : " rad";
+      if (!(std::abs(position) <= kMaxJointPosition)) {
+        return Status::Error("joint " + Quoted(name) + " position " + FormatNumber(position) +
+                             unit + " is outside the allowed range [" +
+                             FormatNumber(-kMaxJointPosition) + ", " +
+                             FormatNumber(kMaxJointPosition) + "]");
+      }
       if (joint.type != urdf::Joint::CONTINUOUS && joint.limits != nullptr &&
           joint.limits->lower <= joint.limits->upper &&
           (position < joint.limits->lower || position > joint.limits->upper)) {
-        const char* unit = joint.type == urdf::Joint::PRISMATIC ? " m" : " rad";
         return Status::Error("joint " + Quoted(name) + " position " + FormatNumber(position) +
                              unit + " is outside its limits [" + FormatNumber(joint.limits->lower) +
                              ", " + FormatNumber(joint.limits->upper) + "]");
       }
     }
-    return Status::Ok();
+    if (Status status = CheckMimicJoints(model); !status.ok()) return status;
+    return SetInitialPositions(model);
   }
 
-  // The position given for a joint; if none, 0 brought within the joint's
-  // limits (a published arm's elbow may have [-2.1, -0.03]). A mimic
-  // joint's follows its leader's.
+  // The position given for a joint that mimics none; if none, 0 brought
+  // within the joint's limits (a published arm's elbow may have
+  // [-2.1, -0.03]).
   double InitialPosition(const urdf::Joint& joint) const {
-    const std::string& name = joint.mimic != nullptr ? joint.mimic->joint_name : joint.name;
-    const auto given = options_.joint_positions.find(name);
-    const double leader = given == options_.joint_positions.end() ? 0.0 : given->second;
-    if (joint.mimic != nullptr) return joint.mimic->multiplier * leader + joint.mimic->offset;
-    if (given != options_.joint_positions.end() || joint.limits == nullptr ||
-        joint.type == urdf::Joint::CONTINUOUS || joint.limits->lower > joint.limits->upper) {
-      return leader;
+    const auto given = options_.joint_positions.find(joint.name);
+    if (given != options_.joint_positions.end()) return given->second;
+    if (joint.limits == nullptr || joint.type == urdf::Joint::CONTINUOUS ||
+        joint.limits->lower > joint.limits->upper) {
+      return 0.0;
     }
     return std::clamp(0.0, joint.limits->lower, joint.limits->upper);
+  }
+
+  // initial_positions_ for every movable joint; a mimic joint's follows its
+  // leader's, as the simulation has it, and is refused beyond
+  // kMaxJointPosition (CheckMimicJoints bounds it over a limited leader's
+  // range; a continuous leader's given position is known only here).
+  Status SetInitialPositions(const urdf::ModelInterface& model) {
+    initial_positions_.clear();
+    for (const auto& [name, joint] : model.joints_) {
+      if (IsWeldable(joint->type) && joint->mimic == nullptr) {
+        initial_positions_[name] = InitialPosition(*joint);
+      }
+    }
+    for (const auto& [name, joint] : model.joints_) {
+      if (!IsWeldable(joint->type) || joint->mimic == nullptr) continue;
+      const urdf::JointMimic& mimic = *joint->mimic;
+      const double leader = initial_positions_.at(mimic.joint_name);
+      const double position = mimic.multiplier * leader + mimic.offset;
+      if (!(std::abs(position) <= kMaxJointPosition)) {
+        return Status::Error(
+            "joint " + Quoted(name) + " <mimic> initial position " + FormatNumber(position) +
+            (joint->type == urdf::Joint::PRISMATIC ? " m" : " rad") + " (multiplier " +
+            FormatNumber(mimic.multiplier) + " times leader " + Quoted(mimic.joint_name) + " at " +
+            FormatNumber(leader) + ", plus offset " + FormatNumber(mimic.offset) +
+            ") is outside the allowed range [" + FormatNumber(-kMaxJointPosition) + ", " +
+            FormatNumber(kMaxJointPosition) + "]");
+      }
+      initial_positions_[name] = position;
+    }
+    return Status::Ok();
   }
 
   static bool IsWeldable(int type) {
@@ -260,7 +299,8 @@ class ModelBuilder {
     info->parent_from_joint = ToPose(joint.parent_to_joint_origin_transform);
     if (joint.type == urdf::Joint::FIXED) return Pose::Identity();
     loaded->articulated = options_.articulate;
-    const double position = InitialPosition(joint);
+    const auto initial = initial_positions_.find(joint.name);
+    const double position = initial == initial_positions_.end() ? 0.0 : initial->second;
     info->position = position;
     if (!options_.articulate) {
       loaded->warnings.push_back("joint " + Quoted(joint.name) + " is " +
@@ -481,6 +521,7 @@ class ModelBuilder {
   const UrdfLoadOptions& options_;
   UriResolver resolver_;
   std::map<std::string, double> friction_;
+  std::map<std::string, double> initial_positions_;  // rad or m, by movable joint (CheckJoints)
   MeshCollisionModes mesh_modes_;
   bool static_model_ = false;                   // fixed to `world`, massless, or spawned static
   bool massless_ = false;                       // every link states mass 0
@@ -492,6 +533,10 @@ Status ValidateOptions(const UrdfLoadOptions& options) {
   if (!PositiveFinite(options.default_density)) {
     return Status::Error("URDF load option default_density must be positive and finite, got " +
                          FormatNumber(options.default_density));
+  }
+  if (options.max_joints < 1) {
+    return Status::Error("URDF load option max_joints must be at least 1, got " +
+                         std::to_string(options.max_joints));
   }
   if (options.max_links < 1) {
     return Status::Error("URDF load option max_links must be at least 1, got " +

@@ -4,6 +4,7 @@
 
 #include "io/urdf_checks.h"
 #include "io/urdf_elements.h"
+#include "rigid_body_sim/io/mesh_process.h"
 
 namespace rigid_body_sim::io {
 
@@ -143,7 +144,12 @@ Result<std::shared_ptr<const std::vector<ConvexPolyhedron>>> UrdfMeshes::LoadPie
   if (options_.mesh_pieces_loader) {
     const Result<std::string> path = resolver_(uri);
     if (!path.ok()) return Out::Error("mesh " + Quoted(uri) + ": " + path.message());
+    // The loader cannot return the disk cache's warnings (MeshPiecesLoader
+    // returns pieces only); they come back through the thread's collector.
+    const MeshCacheWarnings cache_warnings;
     built = options_.mesh_pieces_loader(*path, scale, decomposition, rule);
+    warnings_.insert(warnings_.end(), cache_warnings.warnings().begin(),
+                     cache_warnings.warnings().end());
   } else {
     Result<physics::TriangleMesh> mesh = LoadMesh(uri, scale, resolver_, options_.max_file_bytes);
     if (!mesh.ok()) return mesh.status();

@@ -47,6 +47,10 @@ class UrdfMeshes {
   physics::Result<ShapeWithMass> Pieces(const std::string& uri, const physics::Vec3& scale,
                                         PiecesRule rule, const std::string& where);
 
+  // What the pieces loader's disk cache warned about (MeshCacheWarnings),
+  // for the model's warnings.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
  private:
   using Key = std::tuple<std::string, double, double, double>;
   physics::Result<std::shared_ptr<const physics::CollisionMesh>> LoadTriangles(
@@ -64,6 +68,7 @@ class UrdfMeshes {
   std::map<std::tuple<Key, PiecesRule>,
            std::shared_ptr<const std::vector<physics::ConvexPolyhedron>>>
       pieces_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace rigid_body_sim::io

@@ -8,13 +8,29 @@ namespace rigid_body_sim::node {
 
 using physics::FormatNumber;
 using physics::Result;
+using physics::Status;
 
-Result<JointTrajectory> JointTrajectory::Make(const TrajectoryPoint& start,
+namespace {
+
+// The mean of the slopes to the neighbouring points, the velocity a point
+// without one is given (Catmull-Rom-like, on uneven times).
+void EstimateVelocity(const TrajectoryPoint& before, const TrajectoryPoint& after,
+                      TrajectoryPoint* point) {
+  point->velocities.resize(point->positions.size());
+  for (std::size_t j = 0; j < point->positions.size(); ++j) {
+    const double slope_before =
+        (point->positions[j] - before.positions[j]) / (point->time - before.time);
+    const double slope_after =
+        (after.positions[j] - point->positions[j]) / (after.time - point->time);
+    point->velocities[j] = 0.5 * (slope_before + slope_after);
+  }
+}
+
+}  // namespace
+
+Result<JointTrajectory> JointTrajectory::Plan(std::size_t joints,
                                               std::vector<TrajectoryPoint> points) {
-  const std::size_t joints = start.positions.size();
   if (points.empty()) return Result<JointTrajectory>::Error("the trajectory has no points");
-  JointTrajectory trajectory;
-  if (points.front().time > 0.0) trajectory.points_.push_back(start);
   double previous = -1.0;
   for (std::size_t k = 0; k < points.size(); ++k) {
     const TrajectoryPoint& point = points[k];
@@ -38,22 +54,49 @@ Result<JointTrajectory> JointTrajectory::Make(const TrajectoryPoint& start,
         return Result<JointTrajectory>::Error(where + " has a value that is not finite");
       }
     }
-    trajectory.points_.push_back(point);
   }
-  std::vector<TrajectoryPoint>& all = trajectory.points_;
-  if (all.front().velocities.empty()) all.front().velocities.assign(joints, 0.0);
-  for (std::size_t k = 1; k < all.size(); ++k) {
-    if (!all[k].velocities.empty()) continue;
-    all[k].velocities.assign(joints, 0.0);
-    if (k + 1 == all.size()) continue;
-    for (std::size_t j = 0; j < joints; ++j) {
-      const double before =
-          (all[k].positions[j] - all[k - 1].positions[j]) / (all[k].time - all[k - 1].time);
-      const double after =
-          (all[k + 1].positions[j] - all[k].positions[j]) / (all[k + 1].time - all[k].time);
-      all[k].velocities[j] = 0.5 * (before + after);
+  JointTrajectory trajectory;
+  trajectory.first_velocity_given_ = !points.front().velocities.empty();
+  // Interior points depend only on their neighbours among the points; the
+  // first one's estimate waits for the start (Begin), the last one rests.
+  for (std::size_t k = 1; k + 1 < points.size(); ++k) {
+    if (points[k].velocities.empty()) EstimateVelocity(points[k - 1], points[k + 1], &points[k]);
+  }
+  if (points.size() > 1 && points.back().velocities.empty()) {
+    points.back().velocities.assign(joints, 0.0);
+  }
+  trajectory.points_ = std::move(points);
+  return trajectory;
+}
+
+Status JointTrajectory::Begin(const TrajectoryPoint& start) {
+  const std::size_t joints = points_.front().positions.size();
+  if (start.positions.size() != joints ||
+      (!start.velocities.empty() && start.velocities.size() != joints)) {
+    return Status::Error("the start needs " + std::to_string(joints) + " positions, has " +
+                         std::to_string(start.positions.size()));
+  }
+  if (points_.front().time > 0.0) {
+    points_.insert(points_.begin(), start);
+    if (points_.front().velocities.empty()) points_.front().velocities.assign(joints, 0.0);
+    if (!first_velocity_given_) {
+      if (points_.size() > 2) {
+        EstimateVelocity(points_[0], points_[2], &points_[1]);
+      } else {
+        points_[1].velocities.assign(joints, 0.0);
+      }
     }
+  } else if (!first_velocity_given_) {
+    points_.front().velocities.assign(joints, 0.0);
   }
+  return Status::Ok();
+}
+
+Result<JointTrajectory> JointTrajectory::Make(const TrajectoryPoint& start,
+                                              std::vector<TrajectoryPoint> points) {
+  Result<JointTrajectory> trajectory = Plan(start.positions.size(), std::move(points));
+  if (!trajectory.ok()) return trajectory;
+  if (Status status = trajectory.value().Begin(start); !status.ok()) return status;
   return trajectory;
 }
 
@@ -63,6 +106,9 @@ Result<JointTrajectory> JointTrajectory::Make(const TrajectoryPoint& start,
 // is dp/ds / h (de Boor 1978, "A Practical Guide to Splines", chapter IV).
 TrajectorySample JointTrajectory::Sample(double t) const {
   TrajectorySample sample;
+  // Before the first point (and NaN) is the first point; a trajectory of
+  // one point at time 0 then takes the branch below.
+  if (!(t >= points_.front().time)) t = points_.front().time;
   if (t >= points_.back().time) {
     sample.positions = points_.back().positions;
     sample.velocities = t == points_.back().time
@@ -70,9 +116,12 @@ TrajectorySample JointTrajectory::Sample(double t) const {
                             : std::vector<double>(sample.positions.size(), 0.0);
     return sample;
   }
-  t = std::max(t, points_.front().time);
-  std::size_t k = 0;
-  while (points_[k + 1].time < t) ++k;
+  // The segment [k, k + 1] holding t, by bisection: a trajectory may have
+  // up to ~max_trajectory_points points and is sampled every step.
+  const auto after =
+      std::lower_bound(points_.begin() + 1, points_.end(), t,
+                       [](const TrajectoryPoint& point, double time) { return point.time < time; });
+  const std::size_t k = static_cast<std::size_t>(after - points_.begin()) - 1;
   const TrajectoryPoint& a = points_[k];
   const TrajectoryPoint& b = points_[k + 1];
   const double h = b.time - a.time;

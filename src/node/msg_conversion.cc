@@ -142,6 +142,21 @@ void ModelPropertiesToMsg(const Model& model, rigid_body_sim::GetModelProperties
   msg->is_static = model.is_static;
 }
 
+JointCommandRequest JointCommandFromMsg(const sensor_msgs::JointState& msg) {
+  return JointCommandRequest{msg.name, msg.position, msg.velocity, msg.effort};
+}
+
+JointTrajectoryRequest JointTrajectoryFromMsg(const trajectory_msgs::JointTrajectory& msg) {
+  JointTrajectoryRequest request;
+  request.joint_names = msg.joint_names;
+  request.points.reserve(msg.points.size());
+  for (const trajectory_msgs::JointTrajectoryPoint& point : msg.points) {
+    // toSec is sec + 1e-9 nsec in double: no range to leave.
+    request.points.push_back({point.positions, point.velocities, point.time_from_start.toSec()});
+  }
+  return request;
+}
+
 geometry_msgs::Vector3 VectorToMsg(const Vec3& vector) {
   geometry_msgs::Vector3 msg;
   msg.x = vector.x();

@@ -251,6 +251,11 @@ Status ValidateNodeOptions(const NodeOptions& options) {
     return Status::Error("~max_links_per_model " + std::to_string(options.max_links_per_model) +
                          " must be >= 1");
   }
+  // The articulation holds at most 1000 links (physics/world_articulations.cc).
+  if (Status status = CheckRange("~max_joints_per_model", options.max_joints_per_model, 1, 999, "");
+      !status.ok()) {
+    return status;
+  }
   // The servo is implicit, so any gain is stable; the bound keeps dt k
   // (and so the soft row's terms) far from overflow.
   constexpr double kMaxServoGain = 1e12;
@@ -269,6 +274,11 @@ Status ValidateNodeOptions(const NodeOptions& options) {
   if (!(options.mesh_cpu_limit > 0.0 && options.mesh_cpu_limit <= 3600.0)) {
     return Status::Error("~mesh_cpu_limit " + FormatNumber(options.mesh_cpu_limit) +
                          " s is outside the allowed range (0, 3600] s");
+  }
+  if (Status status = CheckRange("~max_mesh_triangles", options.max_mesh_triangles, 1,
+                                 static_cast<double>(physics::CollisionMesh::kMaxTriangles), "");
+      !status.ok()) {
+    return status;
   }
   if (options.max_file_bytes < 1) {
     return Status::Error("~max_file_bytes " + std::to_string(options.max_file_bytes) +
@@ -393,12 +403,15 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"max_torque", &options->limits.max_torque},
       {"max_wrench_duration", &options->limits.max_wrench_duration},
       {"max_step_count", &options->limits.max_step_count},
+      {"max_trajectory_points", &options->limits.max_trajectory_points},
       {"max_links_per_model", &options->max_links_per_model},
+      {"max_joints_per_model", &options->max_joints_per_model},
       {"joint_stiffness", &options->servo.stiffness},
       {"joint_damping", &options->servo.damping},
       {"max_file_bytes", &options->max_file_bytes},
       {"mesh_memory_limit", &options->mesh_memory_limit},
       {"mesh_cpu_limit", &options->mesh_cpu_limit},
+      {"max_mesh_triangles", &options->max_mesh_triangles},
   };
 }
 

@@ -59,7 +59,11 @@ Status ValidateRequestLimits(const RequestLimits& limits) {
     // is never frozen by it.
     if (Status status = CheckIn(value, 1e-300, 1e100, name, ""); !status.ok()) return status;
   }
-  return CheckIn(limits.max_step_count, 1, 1e9, "~max_step_count", "");
+  if (Status status = CheckIn(limits.max_step_count, 1, 1e9, "~max_step_count", ""); !status.ok()) {
+    return status;
+  }
+  return CheckIn(limits.max_trajectory_points, 1, kMaxTrajectoryPointsLimit,
+                 "~max_trajectory_points", "");
 }
 
 Status ValidateFrameState(const FrameState& state, const RequestLimits& limits) {

@@ -1,5 +1,6 @@
 #include "node/ros_uri.h"
 
+#include <filesystem>
 #include <mutex>
 
 #include <ros/package.h>
@@ -35,7 +36,18 @@ physics::Result<std::string> ResolveRosUri(const std::string& uri) {
     return physics::Result<std::string>::Error("package '" + package + "' of URI '" + uri +
                                                "' is not found");
   }
-  return slash == std::string::npos ? package_path : package_path + rest.substr(slash);
+  if (slash == std::string::npos) return package_path;
+  // The path inside the package, with '.' and '..' resolved by name: one
+  // that climbs above the package's root is refused, and the path handed
+  // on holds no '..' for the system to resolve through a symlink. Links the
+  // package itself holds are followed, as the package's own content.
+  const std::filesystem::path inside =
+      std::filesystem::path(rest.substr(slash + 1)).lexically_normal();
+  if (!inside.empty() && (*inside.begin() == ".." || inside.is_absolute())) {
+    return physics::Result<std::string>::Error("URI '" + uri + "' leaves package '" + package +
+                                               "': package:// paths stay inside their package");
+  }
+  return (std::filesystem::path(package_path) / inside).string();
 }
 
 }  // namespace rigid_body_sim::node

@@ -9,7 +9,8 @@
 namespace rigid_body_sim::node {
 
 // package://<package>/<path> through roslib, file://<path> and plain paths
-// as they are. Fails, naming the URI, on an unknown package.
+// as they are. Fails, naming the URI, on an unknown package, or on a path
+// whose '..' climbs above the package's directory.
 physics::Result<std::string> ResolveRosUri(const std::string& uri);
 
 }  // namespace rigid_body_sim::node

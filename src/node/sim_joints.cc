@@ -7,30 +7,37 @@
 #include <string>
 #include <vector>
 
+#include "rigid_body_sim/node/joint_requests.h"
+#include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 #include "rigid_body_sim/node/request_validation.h"
 #include "rigid_body_sim/node/sim_node.h"
 
 namespace rigid_body_sim::node {
 
+using physics::FormatNumber;
 using physics::JointCommand;
-using physics::JointCommandMode;
+using physics::Result;
 using physics::Status;
 
 void SimNode::AdvertiseJointTopicsLocked(const Model& model) {
   JointTopics topics;
   topics.handle = ros::NodeHandle(private_node_, model.name);
   topics.states = topics.handle.advertise<sensor_msgs::JointState>(names::kJointStatesTopic, 10);
-  const std::string name = model.name;
+  // The callbacks hold what they parse against, so they never read the
+  // registry without the world lock.
+  const std::shared_ptr<const ModelJoints> joints = ModelJointsOf(model);
+  const physics::ArticulationId articulation = model.articulation;
   topics.command = topics.handle.subscribe<sensor_msgs::JointState>(
       names::kJointCommandTopic, 10,
-      [this, name](const sensor_msgs::JointState::ConstPtr& message) {
-        OnJointCommand(name, *message);
+      [this, joints, articulation](const sensor_msgs::JointState::ConstPtr& message) {
+        Guarded(names::kJointCommandTopic, [&] { OnJointCommand(joints, articulation, *message); });
       });
   topics.trajectory = topics.handle.subscribe<trajectory_msgs::JointTrajectory>(
       names::kJointTrajectoryTopic, 10,
-      [this, name](const trajectory_msgs::JointTrajectory::ConstPtr& message) {
-        OnJointTrajectory(name, *message);
+      [this, joints, articulation](const trajectory_msgs::JointTrajectory::ConstPtr& message) {
+        Guarded(names::kJointTrajectoryTopic,
+                [&] { OnJointTrajectory(joints, articulation, *message); });
       });
   std::lock_guard<std::mutex> lock(joint_topics_mutex_);
   joint_topics_[model.name] = std::move(topics);
@@ -54,156 +61,84 @@ void SimNode::DestroyRetiredJointTopics() {
   // Destroyed here, with no lock held.
 }
 
-namespace {
-
-// The index of a movable joint of the model that mimics none, by name.
-physics::Result<int> CommandableJoint(const Model& model, const std::string& name) {
-  int joint = -1;
-  for (std::size_t k = 0; k < model.joint_names.size(); ++k) {
-    if (model.joint_names[k] == name) joint = static_cast<int>(k);
-  }
-  if (joint < 0) {
-    return physics::Result<int>::Error("model '" + model.name + "' has no movable joint '" + name +
-                                       "'");
-  }
-  for (const io::JointInfo& info : model.joints) {
-    if (info.name == name && !info.mimic_joint.empty()) {
-      return physics::Result<int>::Error("joint '" + name + "' mimics '" + info.mimic_joint +
-                                         "'; command that joint instead");
-    }
-  }
-  return joint;
-}
-
-// The validation's view of joint `name` of `model`, values to be filled in.
-JointValues ValuesOf(const Model& model, const std::string& name) {
-  JointValues values;
-  values.field = "joint '" + name + "'";
-  for (const io::JointInfo& info : model.joints) {
-    if (info.name == name) values.prismatic = info.type == "prismatic";
-  }
-  return values;
-}
-
-// The commands of one message, checked whole before any is applied: every
-// name a movable joint of the model that mimics none, given once, each of
-// position, velocity and effort empty or one value per name within the
-// request limits (request_validation.h). The filled field
-// picks the mode: position (a servo, velocity its feed-forward), else
-// velocity (a motor), else effort.
-physics::Result<std::vector<std::pair<int, JointCommand>>> ParseCommand(
-    const Model& model, const sensor_msgs::JointState& message, const RequestLimits& limits) {
-  using Parsed = physics::Result<std::vector<std::pair<int, JointCommand>>>;
-  const std::size_t count = message.name.size();
-  const auto sized = [count](std::size_t size) { return size == 0 || size == count; };
-  if (count == 0) return Parsed::Error("name is empty");
-  if (!sized(message.position.size()) || !sized(message.velocity.size()) ||
-      !sized(message.effort.size())) {
-    return Parsed::Error(
-        "position, velocity and effort must each be empty or have " + std::to_string(count) +
-        " values (one per name); got " + std::to_string(message.position.size()) + ", " +
-        std::to_string(message.velocity.size()) + " and " + std::to_string(message.effort.size()));
-  }
-  if (message.position.empty() && message.velocity.empty() && message.effort.empty()) {
-    return Parsed::Error("none of position, velocity and effort is filled");
-  }
-  std::vector<std::pair<int, JointCommand>> commands;
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::string& name = message.name[i];
-    const physics::Result<int> joint = CommandableJoint(model, name);
-    if (!joint.ok()) return joint.status();
-    for (const auto& [earlier, unused] : commands) {
-      if (earlier == *joint) return Parsed::Error("joint '" + name + "' is named twice");
-    }
-    JointCommand command;
-    const auto value = [i](const std::vector<double>& values) {
-      return values.empty() ? 0.0 : values[i];
-    };
-    command.position = value(message.position);
-    command.velocity = value(message.velocity);
-    command.effort = value(message.effort);
-    JointValues values = ValuesOf(model, name);
-    values.position = command.position;
-    values.velocity = command.velocity;
-    values.effort = command.effort;
-    if (Status status = ValidateJointValues(values, limits); !status.ok()) return status;
-    command.mode = !message.position.empty()   ? JointCommandMode::kPosition
-                   : !message.velocity.empty() ? JointCommandMode::kVelocity
-                                               : JointCommandMode::kEffort;
-    commands.emplace_back(*joint, command);
-  }
-  return commands;
-}
-
-}  // namespace
-
-void SimNode::OnJointCommand(const std::string& model_name,
+void SimNode::OnJointCommand(const std::shared_ptr<const ModelJoints>& joints,
+                             physics::ArticulationId articulation,
                              const sensor_msgs::JointState& message) {
-  std::unique_lock<std::mutex> lock = LockWorld();
-  const Model* model = registry_.Find(model_name);
-  if (model == nullptr || !model->articulation.IsValid()) return;
-  auto commands = ParseCommand(*model, message, options_.limits);
+  const std::string& model_name = joints->model;
+  // Parsed and checked whole before the world is locked.
+  const auto commands = ParseJointCommand(*joints, JointCommandFromMsg(message), options_.limits);
   if (!commands.ok()) {
     ROS_ERROR("%s/%s refused, nothing applied: %s", model_name.c_str(), names::kJointCommandTopic,
               commands.message().c_str());
     return;
   }
+  std::optional<ActiveTrajectory> replaced;  // freed after the lock is released
+  std::unique_lock<std::mutex> lock = LockWorld();
+  if (!IsSameModelLocked(model_name, articulation)) return;
+  const Model* model = registry_.Find(model_name);
   // A command takes over from a trajectory in progress.
-  trajectories_.erase(model_name);
+  if (const auto found = trajectories_.find(model_name); found != trajectories_.end()) {
+    replaced = std::move(found->second);
+    trajectories_.erase(found);
+  }
   for (const auto& [joint, command] : *commands) {
     const Status status = world_.SetJointCommand(model->articulation, joint, command);
     if (!status.ok()) ROS_ERROR("%s: %s", model_name.c_str(), status.message().c_str());
   }
 }
 
-// A trajectory starts at its header stamp (now when zero), from where the
-// joints are, and replaces the one in progress.
-void SimNode::OnJointTrajectory(const std::string& model_name,
-                                const trajectory_msgs::JointTrajectory& message) {
-  std::unique_lock<std::mutex> lock = LockWorld();
+bool SimNode::IsSameModelLocked(const std::string& model_name,
+                                physics::ArticulationId articulation) const {
+  // A message queued for a deleted model, or for an earlier model of the
+  // same name, is dropped.
   const Model* model = registry_.Find(model_name);
-  if (model == nullptr || !model->articulation.IsValid()) return;
+  return model != nullptr && model->articulation.index == articulation.index &&
+         model->articulation.generation == articulation.generation;
+}
+
+// A trajectory starts at its header stamp (now when zero), from where the
+// joints are, and replaces the one in progress. Its points are checked
+// before the world is locked; under the lock only the start is put in.
+void SimNode::OnJointTrajectory(const std::shared_ptr<const ModelJoints>& joints,
+                                physics::ArticulationId articulation,
+                                const trajectory_msgs::JointTrajectory& message) {
+  const std::string& model_name = joints->model;
   const auto refuse = [&model_name](const std::string& why) {
     ROS_ERROR("%s/%s refused, nothing applied: %s", model_name.c_str(),
               names::kJointTrajectoryTopic, why.c_str());
   };
-  ActiveTrajectory active;
-  const std::vector<physics::JointState> states = world_.GetJointStates(model->articulation);
-  TrajectoryPoint start;
-  for (const std::string& name : message.joint_names) {
-    const physics::Result<int> joint = CommandableJoint(*model, name);
-    if (!joint.ok()) return refuse(joint.message());
-    if (std::find(active.joints.begin(), active.joints.end(), *joint) != active.joints.end()) {
-      return refuse("joint '" + name + "' is named twice");
-    }
-    active.joints.push_back(*joint);
-    start.positions.push_back(states[*joint].position);
-    start.velocities.push_back(states[*joint].velocity);
+  if (Status status = ValidateTrajectorySize(message.points.size(), options_.limits);
+      !status.ok()) {
+    return refuse(status.message());
   }
-  if (active.joints.empty()) return refuse("joint_names is empty");
-  std::vector<TrajectoryPoint> points;
-  for (std::size_t p = 0; p < message.points.size(); ++p) {
-    const trajectory_msgs::JointTrajectoryPoint& point = message.points[p];
-    for (std::size_t k = 0; k < message.joint_names.size(); ++k) {
-      JointValues values = ValuesOf(*model, message.joint_names[k]);
-      values.field = "point " + std::to_string(p) + " " + values.field;
-      values.position = k < point.positions.size() ? point.positions[k] : 0.0;
-      values.velocity = k < point.velocities.size() ? point.velocities[k] : 0.0;
-      if (Status status = ValidateJointValues(values, options_.limits); !status.ok()) {
-        return refuse(status.message());
-      }
-    }
-    points.push_back(
-        TrajectoryPoint{point.time_from_start.toSec(), point.positions, point.velocities});
-  }
-  physics::Result<JointTrajectory> plan = JointTrajectory::Make(start, std::move(points));
-  if (!plan.ok()) return refuse(plan.message());
-  active.plan = std::move(plan).value();
+  Result<ParsedTrajectory> parsed =
+      ParseJointTrajectory(*joints, JointTrajectoryFromMsg(message), options_.limits);
+  if (!parsed.ok()) return refuse(parsed.message());
+  ActiveTrajectory active{std::move(parsed.value().joints), std::move(parsed.value().plan), 0.0};
+  std::unique_lock<std::mutex> lock = LockWorld();
+  if (!IsSameModelLocked(model_name, articulation)) return;
+  const Model* model = registry_.Find(model_name);
   active.start_time = world_.time();
   if (!message.header.stamp.isZero()) {
-    active.start_time += (message.header.stamp - StampLocked()).toSec();
+    // In seconds as doubles: ros::Time arithmetic throws beyond its range.
+    const double offset = message.header.stamp.toSec() - StampLocked().toSec();
+    if (!(std::abs(offset) <= kMaxTrajectoryStampOffset)) {
+      return refuse("header.stamp " + FormatNumber(message.header.stamp.toSec()) + " s is " +
+                    FormatNumber(offset) + " s from the node's clock (" +
+                    FormatNumber(StampLocked().toSec()) + " s); allowed within " +
+                    FormatNumber(kMaxTrajectoryStampOffset) + " s of it, or 0 for now");
+    }
+    active.start_time += offset;
   }
-  trajectories_[model_name] = std::move(active);
+  const std::vector<physics::JointState> states = world_.GetJointStates(model->articulation);
+  TrajectoryPoint start;
+  for (const int joint : active.joints) {
+    start.positions.push_back(states[joint].position);
+    start.velocities.push_back(states[joint].velocity);
+  }
+  if (Status status = active.plan.Begin(start); !status.ok()) return refuse(status.message());
+  // The one replaced is freed by `active` after the lock is released.
+  std::swap(trajectories_[model_name], active);
 }
 
 void SimNode::FollowTrajectoriesLocked() {
@@ -219,7 +154,7 @@ void SimNode::FollowTrajectoriesLocked() {
     const TrajectorySample sample = active.plan.Sample(t);
     for (std::size_t k = 0; k < active.joints.size(); ++k) {
       JointCommand command;
-      command.mode = JointCommandMode::kPosition;
+      command.mode = physics::JointCommandMode::kPosition;
       command.position = sample.positions[k];
       command.velocity = sample.velocities[k];
       const Status status = world_.SetJointCommand(model->articulation, active.joints[k], command);
@@ -298,7 +233,11 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
         request.joint_names.begin() + i) {
       return fail("joint_names[" + std::to_string(i) + "] '" + name + "' is given twice");
     }
-    JointValues values = ValuesOf(*model, name);
+    JointValues values;
+    values.field = "joint '" + name + "'";
+    for (const io::JointInfo& info : model->joints) {
+      if (info.name == name) values.prismatic = info.type == "prismatic";
+    }
     values.position = request.positions[i];
     values.velocity = request.velocities.empty() ? 0.0 : request.velocities[i];
     if (Status status = ValidateJointValues(values, options_.limits); !status.ok()) {

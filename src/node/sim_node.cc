@@ -48,6 +48,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
   load_options_.balance_inertia = options_.balance_inertia;
   load_options_.hull.max_vertices = options_.max_hull_vertices;
   load_options_.max_links = options_.max_links_per_model;
+  load_options_.max_joints = options_.max_joints_per_model;
   load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);
   // Meshes are untrusted files: assimp and qhull run in the helper process.
   io::MeshProcessLimits mesh_limits;
@@ -55,6 +56,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
   mesh_limits.memory_bytes = static_cast<std::uint64_t>(options_.mesh_memory_limit);
   mesh_limits.cpu_seconds = options_.mesh_cpu_limit;
   mesh_limits.max_file_bytes = static_cast<std::uint64_t>(options_.max_file_bytes);
+  mesh_limits.max_triangles = static_cast<std::uint64_t>(options_.max_mesh_triangles);
   load_options_.mesh_hull_loader = [mesh_limits](const std::string& path,
                                                  const physics::Vec3& scale,
                                                  const io::HullOptions& hull) {
@@ -164,7 +166,8 @@ Status SimNode::Start() {
     if (!id.ok()) return Status::Error("ground plane: " + id.message());
     ground_ = *id;
     body_markers_[names::kGroundName] =
-        ShapeMarkers(ground.shapes, names::kGroundName, options_.world_frame);
+        std::make_shared<const std::vector<visualization_msgs::Marker>>(
+            ShapeMarkers(ground.shapes, names::kGroundName, options_.world_frame));
   }
 
   for (const ModelSpec& spec : options_.models) {
@@ -219,6 +222,12 @@ Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
   io::UrdfLoadOptions options = load_options_;
   options.joint_positions = spec.joint_positions;
   options.spawn_static = spec.is_static;
+  if (spec.urdf.size() > options.max_file_bytes) {
+    // The same bound as a URDF file's, before the XML parser sees it.
+    return Result<io::LoadedModel>::Error("urdf has " + std::to_string(spec.urdf.size()) +
+                                          " bytes, more than ~max_file_bytes " +
+                                          std::to_string(options.max_file_bytes));
+  }
   if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, options);
   if (spec.urdf_path.empty()) {
     return Result<io::LoadedModel>::Error("neither urdf nor urdf_path is given");
@@ -227,6 +236,31 @@ Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
   if (!path.ok()) return path.status();
   return io::LoadUrdfFile(*path, options);
 }
+
+namespace {
+
+// The collision shapes of a model being spawned: for an articulated one, a
+// marker per shape in its link's frame, ids running on across the links so
+// that none replaces another; else the body's shapes in its root frame.
+std::vector<visualization_msgs::Marker> SpawnMarkers(const std::string& name,
+                                                     const io::LoadedModel& loaded,
+                                                     const physics::BodyDef& def,
+                                                     const physics::ArticulationDef* articulation) {
+  if (articulation == nullptr) {
+    return ShapeMarkers(def.shapes, name, FrameName(name, loaded.root_link));
+  }
+  std::vector<visualization_msgs::Marker> markers;
+  for (const physics::LinkDef& link : articulation->links) {
+    for (visualization_msgs::Marker& marker :
+         ShapeMarkers(link.shapes, name, FrameName(name, link.name))) {
+      marker.id = static_cast<int>(markers.size());
+      markers.push_back(std::move(marker));
+    }
+  }
+  return markers;
+}
+
+}  // namespace
 
 Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
   using FramesResult = Result<std::vector<std::string>>;
@@ -254,7 +288,12 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     articulation = std::move(made).value();
   }
 
+  // The markers hold every triangle of a static mesh (6 M points for a
+  // 2 M-triangle terrain): built and copied before the world is locked.
+  std::vector<visualization_msgs::Marker> markers =
+      SpawnMarkers(spec.name, *loaded, *def, articulation ? &*articulation : nullptr);
   Outbox outbox;
+  outbox.body_markers.emplace().markers = markers;
   std::vector<std::string> frames;
   {
     std::unique_lock<std::mutex> lock = LockWorld();
@@ -274,22 +313,8 @@ Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
     for (const io::LinkFrame& link : model.links) {
       frames.push_back(FrameName(spec.name, link.link_name));
     }
-    std::vector<visualization_msgs::Marker> markers;
-    if (articulation) {
-      // One marker per shape, in its articulation link's frame; ids run on
-      // across the links so that none replaces another.
-      for (const physics::LinkDef& link : articulation->links) {
-        for (visualization_msgs::Marker& marker :
-             ShapeMarkers(link.shapes, spec.name, FrameName(spec.name, link.name))) {
-          marker.id = static_cast<int>(markers.size());
-          markers.push_back(std::move(marker));
-        }
-      }
-    } else {
-      markers = ShapeMarkers(def->shapes, spec.name, FrameName(spec.name, loaded->root_link));
-    }
-    outbox.body_markers.emplace().markers = markers;
-    body_markers_[spec.name] = std::move(markers);
+    body_markers_[spec.name] =
+        std::make_shared<const std::vector<visualization_msgs::Marker>>(std::move(markers));
     const Status added = registry_.Add(std::move(model));
     assert(added.ok());
     const Model& stored = *registry_.Find(spec.name);

@@ -90,8 +90,10 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
     if (model->articulation.IsValid()) RemoveJointTopics(request.name);
     registry_.Remove(request.name);
     frozen_models_.erase(request.name);
-    const int marker_count = static_cast<int>(body_markers_[request.name].size());
-    body_markers_.erase(request.name);
+    const auto found = body_markers_.find(request.name);
+    const int marker_count =
+        found != body_markers_.end() ? static_cast<int>(found->second->size()) : 0;
+    if (found != body_markers_.end()) body_markers_.erase(found);
     outbox.body_markers.emplace().markers = DeleteMarkers(request.name, marker_count);
     if (was_static) outbox.tf_static = StaticTfLocked();
   }
@@ -330,12 +332,14 @@ bool SimNode::OnSetPhysics(rigid_body_sim::SetPhysics::Request& request,
 
 void SimNode::OnBodyMarkersSubscriber(const ros::SingleSubscriberPublisher& publisher) {
   try {
-    visualization_msgs::MarkerArray array;
+    std::vector<MarkerList> lists;
     {
       std::unique_lock<std::mutex> lock = LockWorld();
-      for (const auto& [name, markers] : body_markers_) {
-        array.markers.insert(array.markers.end(), markers.begin(), markers.end());
-      }
+      for (const auto& [name, markers] : body_markers_) lists.push_back(markers);
+    }
+    visualization_msgs::MarkerArray array;
+    for (const MarkerList& markers : lists) {
+      array.markers.insert(array.markers.end(), markers->begin(), markers->end());
     }
     publisher.publish(array);
   } catch (const std::exception& error) {

@@ -29,7 +29,7 @@ void SimNode::StartReconfigure() {
   // before its callback can apply anything.
   PushReconfigureConfig();
   reconfigure_->setCallback([this](rigid_body_sim::PhysicsConfig& config, std::uint32_t level) {
-    OnReconfigure(config, level);
+    Guarded("dynamic_reconfigure", [&] { OnReconfigure(config, level); });
   });
 }
 

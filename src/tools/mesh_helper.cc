@@ -6,8 +6,8 @@
 //
 // Usage: rigid_body_sim_mesh_helper PATH SX SY SZ MAX_VERTICES
 //        DEGENERATE_TOLERANCE MEMORY_BYTES CPU_SECONDS MAX_FILE_BYTES
-//    or: rigid_body_sim_mesh_helper --triangles PATH SX SY SZ MEMORY_BYTES
-//        CPU_SECONDS MAX_FILE_BYTES
+//    or: rigid_body_sim_mesh_helper --triangles PATH SX SY SZ MAX_TRIANGLES
+//        MEMORY_BYTES CPU_SECONDS MAX_FILE_BYTES
 // (the triangles themselves, for a static mesh that collides as them)
 //    or: rigid_body_sim_mesh_helper --pieces PATH SX SY SZ auto|always
 //        MAX_VERTICES DEGENERATE_TOLERANCE VOXELS MAX_PIECES MAX_CONCAVITY
@@ -15,6 +15,7 @@
 // (the convex pieces of a moving mesh, io/convex_decomposition.h).
 #include <sys/resource.h>
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -114,11 +115,53 @@ int Serve(
   }
 }
 
-// --triangles: the scaled triangles of the file.
+// `path` is "mesh '<file>' " where the reply does not name the file itself.
+std::string TooManyTriangles(const std::string& path, unsigned long long count,
+                             unsigned long long most) {
+  return path + "has " + std::to_string(count) + " triangles, more than the limit of " +
+         std::to_string(most) + " for a static mesh (~max_mesh_triangles)";
+}
+
+// A binary STL's triangle count, from its header, when the file is one: 80
+// bytes, a uint32 count n, and 50 bytes per triangle, 84 + 50 n in all.
+// Read before the importer runs, so an oversized terrain is refused at once.
+bool BinaryStlTriangles(const std::string& path, unsigned long long* count) {
+  const std::size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos) return false;
+  std::string extension = path.substr(dot);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".stl") return false;
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return false;
+  unsigned char header[84];
+  const bool read = std::fread(header, 1, sizeof(header), file) == sizeof(header);
+  const bool sized = std::fseek(file, 0, SEEK_END) == 0;
+  const long size = sized ? std::ftell(file) : -1;
+  std::fclose(file);
+  if (!read || size < 84) return false;
+  const unsigned long long n = static_cast<unsigned long long>(header[80]) |
+                               static_cast<unsigned long long>(header[81]) << 8 |
+                               static_cast<unsigned long long>(header[82]) << 16 |
+                               static_cast<unsigned long long>(header[83]) << 24;
+  if (84 + 50 * n != static_cast<unsigned long long>(size)) return false;  // ASCII
+  *count = n;
+  return true;
+}
+
+// --triangles: the scaled triangles of the file, at most MAX_TRIANGLES.
 int ReplyTriangles(int argc, char** argv) {
   using rigid_body_sim::io::FormatErrorReply;
-  if (argc != 9) return Reply(FormatErrorReply("mesh helper: expected 8 arguments"), 2);
-  return Serve(ReadRequest(argc, argv, 2), [](const rigid_body_sim::physics::TriangleMesh& mesh) {
+  if (argc != 10) return Reply(FormatErrorReply("mesh helper: expected 9 arguments"), 2);
+  const Request request = ReadRequest(argc, argv, 2);
+  const unsigned long long most = std::strtoull(argv[6], nullptr, 10);
+  if (unsigned long long count = 0; BinaryStlTriangles(request.path, &count) && count > most) {
+    return Reply(FormatErrorReply(TooManyTriangles("mesh '" + request.path + "' ", count, most)),
+                 1);
+  }
+  return Serve(request, [&](const rigid_body_sim::physics::TriangleMesh& mesh) {
+    if (mesh.triangles.size() > most) {
+      return Result<std::string>::Error(TooManyTriangles("", mesh.triangles.size(), most));
+    }
     return Result<std::string>(rigid_body_sim::io::FormatTrianglesReply(mesh));
   });
 }

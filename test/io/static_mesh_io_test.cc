@@ -4,6 +4,11 @@
 // checked.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <variant>
@@ -75,6 +80,71 @@ TEST(StaticMeshIoTest, HelperTrianglesAreTheInProcessTrianglesExactly) {
   EXPECT_EQ(remote->vertices, local->vertices);
   EXPECT_EQ(remote->triangles, local->triangles);
   EXPECT_EQ(remote->triangles.size(), 28u);
+}
+
+// The helper sends a static mesh's triangles as raw doubles and indices
+// after a header line: the parse gives back every bit, and any byte count,
+// index or coordinate that does not fit is refused.
+TEST(StaticMeshIoTest, BinaryTrianglesReplyRoundTripsAndIsChecked) {
+  physics::TriangleMesh mesh;
+  mesh.vertices = {Vec3(0, 0, 0), Vec3(1.0 / 3.0, 0, 1e-300), Vec3(0, 0.1, -7.25)};
+  mesh.triangles = {Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(2, 1, 0)};
+  const std::string reply = FormatTrianglesReply(mesh);
+  EXPECT_EQ(reply.rfind("triangles-binary 3 2\n", 0), 0u);
+  EXPECT_EQ(reply.size(), std::string("triangles-binary 3 2\n").size() + 3 * 24 + 2 * 12);
+  const Result<physics::TriangleMesh> back = ParseTrianglesReply(reply);
+  ASSERT_TRUE(back.ok()) << back.message();
+  EXPECT_EQ(back->vertices, mesh.vertices);
+  EXPECT_EQ(back->triangles, mesh.triangles);
+  EXPECT_NE(ParseTrianglesReply(reply.substr(0, reply.size() - 1)).message().find("expected"),
+            std::string::npos);
+  std::string bad_index = reply;
+  bad_index[bad_index.size() - 4] = 3;  // the last index, little end first
+  EXPECT_NE(ParseTrianglesReply(bad_index).message().find("vertex index outside"),
+            std::string::npos);
+  physics::TriangleMesh not_finite = mesh;
+  not_finite.vertices[1].y() = std::numeric_limits<double>::infinity();
+  EXPECT_NE(ParseTrianglesReply(FormatTrianglesReply(not_finite)).message().find("not finite"),
+            std::string::npos);
+}
+
+// A binary STL of n triangles is 84 + 50 n bytes with n in its header: the
+// helper refuses one above ~max_mesh_triangles before assimp reads it, so
+// the refusal comes at once and names the limit.
+TEST(StaticMeshIoTest, TriangleLimitIsMetBeforeTheFileIsRead) {
+  const std::string path = ::testing::TempDir() + "/rbs_too_many_triangles.stl";
+  const std::uint32_t count = 50000;
+  {
+    std::ofstream file(path, std::ios::binary);
+    file << std::string(80, ' ');
+    file.write(reinterpret_cast<const char*>(&count), sizeof(count));
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const float x = static_cast<float>(i % 250);
+      const float y = static_cast<float>(i / 250);
+      const float record[12] = {0, 0, 1, x, y, 0, x + 1, y, 0, x, y + 1, 0};
+      file.write(reinterpret_cast<const char*>(record), sizeof(record));
+      file.write("\0\0", 2);
+    }
+  }
+  MeshProcessLimits limits = HelperLimits();
+  limits.max_triangles = count - 1;
+  const auto start = std::chrono::steady_clock::now();
+  const Result<physics::TriangleMesh> refused =
+      LoadMeshTrianglesOutOfProcess(path, Vec3::Ones(), limits);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("has 50000 triangles, more than the limit of 49999"),
+            std::string::npos)
+      << refused.message();
+  EXPECT_NE(refused.message().find("~max_mesh_triangles"), std::string::npos);
+  EXPECT_LT(seconds, 1.0);
+  limits.max_triangles = count;
+  const Result<physics::TriangleMesh> loaded =
+      LoadMeshTrianglesOutOfProcess(path, Vec3::Ones(), limits);
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  EXPECT_EQ(loaded->triangles.size(), count);
+  std::remove(path.c_str());
 }
 
 TEST(StaticMeshIoTest, TrianglesReplyIsChecked) {

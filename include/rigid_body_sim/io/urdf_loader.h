@@ -23,6 +23,13 @@
 
 namespace rigid_body_sim::io {
 
+// Movable joints of one articulated model by default (~max_joints_per_model):
+// the dense dynamics cost about n^3 per evaluation, and a 64-joint chain's
+// worst step (a swinging heavy tip, the energy balance split 64 times) takes
+// 70 ms on the reference machine; 1000 joints would take seconds, holding
+// every other call of the node.
+inline constexpr int kDefaultMaxJointsPerModel = 64;
+
 // Limits on collision geometry: every size of a box, cylinder, sphere or
 // mesh hull (m), and a shape's largest size over its smallest. Outside them
 // the convex-polyhedron builder degenerates or the solver's scales part by
@@ -30,6 +37,23 @@ namespace rigid_body_sim::io {
 inline constexpr double kMinShapeSize = 1e-4;
 inline constexpr double kMaxShapeSize = 1e4;
 inline constexpr double kMaxShapeAspectRatio = 1e3;
+
+// Limits on joints. The first two match the node's (request_validation.h,
+// which this ROS-free library does not include): kMaxJointPosition, the
+// |position| every joint request is held to (rad or m; a continuous joint
+// wound further has lost its angle's precision below 1e-12 rad), and the
+// default ~max_angular_speed and ~max_linear_speed (rad/s or m/s).
+inline constexpr double kMaxJointPosition = 1e4;
+inline constexpr double kMaxJointSpeed = 1e4;
+// |<mimic multiplier>|: each mimic adds its multiplier squared to its
+// leader's effort scale and joint-space inertia, so 1e3 keeps them within
+// 1e6 of the leader's own. A multiplier of 0 (a joint held at its offset)
+// is legal, as in urdfdom and Gazebo.
+inline constexpr double kMaxMimicMultiplier = 1e3;
+// <gazebo><mu1> above this (the node's bound on a spawn request's friction)
+// is read as this: descriptions write 1e5 to 1e15 for "never slides", which
+// 1e3 (a cone of 89.94 degrees) already is.
+inline constexpr double kMaxFrictionCoefficient = 1e3;
 
 // Builds the hull of the mesh file at a resolved local `path`, scaled per
 // axis; e.g. CachedMeshHull (mesh_process.h), out of process.
@@ -63,6 +87,10 @@ struct UrdfLoadOptions {
   bool balance_inertia = false;
   HullOptions hull;      // for <mesh> collisions
   int max_links = 1000;  // count, >= 1: a model with more <link>s is refused
+  // count, >= 1: an articulated model with more movable joints is refused;
+  // the default is the largest whose worst step stays within tens of
+  // milliseconds (docs/limits.md).
+  int max_joints = kDefaultMaxJointsPerModel;
   // Bytes; a URDF or mesh file larger than this, or not a regular file
   // (/dev/zero, a FIFO), is refused before it is read.
   std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;
@@ -99,8 +127,10 @@ struct UrdfLoadOptions {
   bool articulate = false;
   bool weld_movable_joints = false;
   // By joint name, the initial position of each movable joint (0 when not
-  // listed); every name must be a movable joint of the model that mimics
-  // none, and every value within the joint's limits, or the load fails.
+  // listed, brought within the joint's limits); every name must be a
+  // movable joint of the model that mimics none, and every value within the
+  // joint's limits and within kMaxJointPosition, or the load fails. A mimic
+  // joint starts at multiplier * its leader's initial position + offset.
   std::map<std::string, double> joint_positions;
 };
 
@@ -160,9 +190,10 @@ struct LoadedModel {
 // Parses a URDF document. Fails, naming the element, on malformed XML,
 // unsupported or (unless welded, see UrdfLoadOptions) movable joints, bad
 // joint positions, invalid <inertial>, unreadable or degenerate meshes, sizes
-// outside the limits above, more links than options.max_links, or a model
-// without collision geometry. Relative mesh paths are
-// taken relative to the working directory.
+// or other numbers outside the limits above (or their own, urdf_checks.h),
+// mimic joints that would move beyond kMaxJointPosition or kMaxJointSpeed,
+// more links than options.max_links, or a model without collision geometry.
+// Relative mesh paths are taken relative to the working directory.
 physics::Result<LoadedModel> LoadUrdfString(const std::string& xml,
                                             const UrdfLoadOptions& options = {});
 

@@ -30,6 +30,12 @@ class JointTrajectory {
   // the neighbouring points, 0 at the last point.
   static physics::Result<JointTrajectory> Make(const TrajectoryPoint& start,
                                                std::vector<TrajectoryPoint> points);
+  // Make in two parts, so that the costly one needs no world: Plan checks
+  // and prepares `points` for `joints` joints (O(points x joints)), Begin
+  // puts the start in front (O(joints)); Sample only after Begin.
+  static physics::Result<JointTrajectory> Plan(std::size_t joints,
+                                               std::vector<TrajectoryPoint> points);
+  physics::Status Begin(const TrajectoryPoint& start);
 
   // The commanded positions and velocities at time t (s from the start);
   // after the last point, its positions at rest.
@@ -37,7 +43,8 @@ class JointTrajectory {
   double duration() const { return points_.back().time; }
 
  private:
-  std::vector<TrajectoryPoint> points_;  // the start first
+  std::vector<TrajectoryPoint> points_;  // the start first, after Begin
+  bool first_velocity_given_ = false;    // points[0] came with velocities
 };
 
 }  // namespace rigid_body_sim::node

@@ -13,6 +13,8 @@
 #include <geometry_msgs/Twist.h>
 #include <geometry_msgs/Vector3.h>
 #include <ros/time.h>
+#include <sensor_msgs/JointState.h>
+#include <trajectory_msgs/JointTrajectory.h>
 #include <visualization_msgs/Marker.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -20,6 +22,7 @@
 #include "rigid_body_sim/GetModelProperties.h"
 #include "rigid_body_sim/PhysicsConfig.h"
 #include "rigid_body_sim/Spawn.h"
+#include "rigid_body_sim/node/joint_requests.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
 #include "rigid_body_sim/physics/contact.h"
@@ -46,6 +49,11 @@ physics::Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
 // The spawn request as a spec; checks the pose, the twist and that the joint
 // fields pair up without repeats (the loader checks names and limits).
 physics::Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request);
+
+// The joint topics' messages as the plain requests joint_requests.h checks;
+// copied as they are (the stamp is the caller's).
+JointCommandRequest JointCommandFromMsg(const sensor_msgs::JointState& msg);
+JointTrajectoryRequest JointTrajectoryFromMsg(const trajectory_msgs::JointTrajectory& msg);
 
 // --- core to messages ---------------------------------------------------------
 

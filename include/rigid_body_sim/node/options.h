@@ -9,6 +9,7 @@
 
 #include <ros/node_handle.h>
 
+#include "rigid_body_sim/io/mesh_process.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/request_validation.h"
 #include "rigid_body_sim/physics/result.h"
@@ -59,10 +60,14 @@ struct NodeOptions {
   double contact_force_scale = 0.02;
   // ~max_position (m, 1e6), ~max_linear_speed (m/s, 1e4),
   // ~max_angular_speed (rad/s, 1e4), ~max_force (N, 1e9), ~max_torque (N m,
-  // 1e9), ~max_wrench_duration (s, 3600), ~max_step_count (count, 100000):
+  // 1e9), ~max_wrench_duration (s, 3600), ~max_step_count (count, 100000),
+  // ~max_trajectory_points (count, 100000, [1, 1e7]):
   // requests beyond them are refused (request_validation.h).
   RequestLimits limits;
   int max_links_per_model = 1000;  // ~max_links_per_model: count, >= 1
+  // ~max_joints_per_model: count, [1, 1000]: movable joints of one
+  // articulated model (io::kDefaultMaxJointsPerModel, 64).
+  int max_joints_per_model = io::kDefaultMaxJointsPerModel;
   // The position servo of joint commands (physics/articulation.h):
   // ~joint_stiffness (N m/rad or N/m, 1e5, (0, 1e12]) and ~joint_damping
   // (N m s/rad or N s/m, 1e3, [0, 1e12]).
@@ -71,6 +76,9 @@ struct NodeOptions {
   // Limits of the mesh helper process (io/mesh_process.h).
   int mesh_memory_limit = 1 << 30;  // ~mesh_memory_limit: bytes of address space, >= 2^24
   double mesh_cpu_limit = 10.0;     // ~mesh_cpu_limit: s of CPU, (0, 3600]
+  // ~max_mesh_triangles: count, [1, 2^24]: triangles of one static mesh
+  // (io::kDefaultMaxMeshTriangles, 4 Mi by default).
+  int max_mesh_triangles = static_cast<int>(io::kDefaultMaxMeshTriangles);
   // ~models: spawned at start-up, in order; each entry has the fields of
   // Spawn (name, urdf, urdf_path, is_static, friction, restitution), pose:
   // [x, y, z, roll, pitch, yaw] (m, rad; default all 0) and twist:

@@ -24,6 +24,10 @@ struct RequestLimits {
   double max_torque = 1e9;              // ~max_torque: N m
   double max_wrench_duration = 3600.0;  // ~max_wrench_duration: s
   int max_step_count = 100000;          // ~max_step_count: steps per ~step call
+  // ~max_trajectory_points: points of one joint_trajectory message. Sampling
+  // is O(log points) per step; the points are checked outside the world
+  // lock, about 0.2 us per joint and point.
+  int max_trajectory_points = 100000;
 };
 
 // Fixed ranges. A time step above kWarnTimeStep is allowed with a warning:
@@ -40,6 +44,12 @@ inline constexpr double kMaxQuaternionNorm = 1e9;
 // |position| of a joint in a request, rad or m: a continuous joint wound
 // further has lost its angle's precision below 1e-12 rad.
 inline constexpr double kMaxJointPosition = 1e4;
+// |header.stamp - now| of a joint_trajectory, s: a trajectory starts at its
+// stamp, so one stamped further away would start or have ended out of any
+// run's reach (a stamp of 2^32 s is 136 years off).
+inline constexpr double kMaxTrajectoryStampOffset = 3600.0;
+// The largest ~max_trajectory_points allowed.
+inline constexpr int kMaxTrajectoryPointsLimit = 10000000;
 
 // One joint's values in a request (spawn, ~set_joint_state, joint_command,
 // joint_trajectory): |position| <= kMaxJointPosition, |velocity| within

@@ -43,6 +43,7 @@
 #include "rigid_body_sim/Spawn.h"
 #include "rigid_body_sim/Step.h"
 #include "rigid_body_sim/io/urdf_loader.h"
+#include "rigid_body_sim/node/joint_requests.h"
 #include "rigid_body_sim/node/joint_trajectory.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
@@ -116,9 +117,19 @@ class SimNode {
   // a command arriving with the delete would deadlock the node.
   void RemoveJointTopics(const std::string& model_name);
   void DestroyRetiredJointTopics();
-  void OnJointCommand(const std::string& model_name, const sensor_msgs::JointState& command);
-  void OnJointTrajectory(const std::string& model_name,
+  // The joint topics' callbacks: `joints` is what the model was spawned
+  // with; a message for a model since deleted (or spawned anew under the
+  // same name) finds another `articulation` and is dropped.
+  void OnJointCommand(const std::shared_ptr<const ModelJoints>& joints,
+                      physics::ArticulationId articulation, const sensor_msgs::JointState& command);
+  void OnJointTrajectory(const std::shared_ptr<const ModelJoints>& joints,
+                         physics::ArticulationId articulation,
                          const trajectory_msgs::JointTrajectory& trajectory);
+  bool IsSameModelLocked(const std::string& model_name, physics::ArticulationId articulation) const;
+  // Runs a topic or timer callback so that no exception leaves it: roscpp
+  // would end the process. A throw is logged with `what` and dropped.
+  template <typename Callback>
+  void Guarded(const char* what, const Callback& callback);
   // Before each step: every active trajectory's position and velocity at
   // the step's end become its joints' servo commands.
   void FollowTrajectoriesLocked();
@@ -250,7 +261,10 @@ class SimNode {
   ModelRegistry registry_;
   std::optional<physics::BodyId> ground_;
   std::vector<ActiveWrench> wrenches_;
-  std::map<std::string, std::vector<visualization_msgs::Marker>> body_markers_;  // by model
+  // By model; shared, so that a new subscriber's copy (a static terrain's
+  // markers hold millions of points) is made without the world lock.
+  using MarkerList = std::shared_ptr<const std::vector<visualization_msgs::Marker>>;
+  std::map<std::string, MarkerList> body_markers_;
   std::set<std::string> frozen_models_;  // frozen by the step guard, until set_state or reset
   bool paused_ = false;
   // A ~step call runs in chunks; between them ~cancel_step can stop it.
@@ -281,6 +295,15 @@ class SimNode {
 
   std::thread loop_thread_;
 };
+
+template <typename Callback>
+void SimNode::Guarded(const char* what, const Callback& callback) {
+  try {
+    callback();
+  } catch (const std::exception& error) {
+    ROS_ERROR("%s: dropped after an internal error: %s", what, error.what());
+  }
+}
 
 }  // namespace rigid_body_sim::node
 
