@@ -172,7 +172,7 @@ bench: deps
 	cmake -S $(ROOT) -B $(BENCH_BUILD) -DRBS_CORE_ONLY=ON -DRBS_BENCH=ON -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" > /dev/null
 	cmake --build $(BENCH_BUILD) -j$(JOBS) \
-	  --target physics_bench hull_bench narrow_phase_bench broad_phase_bench
+	  --target physics_bench hull_bench narrow_phase_bench broad_phase_bench chain_scaling_bench
 	mkdir -p $(ROOT)/bench/results
 	@echo "[bench] $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $$(date -u '+%F %H:%M UTC')"
 	$(BENCH_BUILD)/physics_bench --runs $(BENCH_RUNS) --scale $(BENCH_SCALE) \
@@ -184,6 +184,7 @@ bench: deps
 	else echo "spawn: node not built ($(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node; make build)"; fi
 	$(BENCH_BUILD)/narrow_phase_bench 200000
 	$(BENCH_BUILD)/broad_phase_bench 30
+	$(BENCH_BUILD)/chain_scaling_bench 480
 	python3 $(ROOT)/bench/plot.py $(ROOT)/bench/results/latest.csv $(ROOT)/bench/results/ms_per_step.png
 	@echo "[bench] ours against Bullet, wall clock and per awake step (bench/ratios.py):"
 	@python3 $(ROOT)/bench/ratios.py $(ROOT)/bench/results/latest.csv

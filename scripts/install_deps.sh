@@ -17,6 +17,7 @@ packages=(
   python3-rosgraph-msgs python3-tf2-msgs python3-diagnostic-msgs python3-sensor-msgs
   python3-trajectory-msgs libtrajectory-msgs-dev python3-tf2-ros
   clang libclang-rt-14-dev
+  ros-robot-state-publisher tf2-tools python3-yaml
 )
 
 missing=()
@@ -38,10 +39,17 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 
 echo "[deps] installing ${#missing[@]} packages: ${missing[*]}"
+# Another apt (unattended-upgrades, a second make) may hold the dpkg lock:
+# wait for it, up to DEPS_LOCK_TIMEOUT seconds, instead of failing at once.
+lock_timeout=${DEPS_LOCK_TIMEOUT:-600}
+if command -v fuser > /dev/null && fuser /var/lib/dpkg/lock-frontend /var/lib/apt/lists/lock > /dev/null 2>&1; then
+  echo "[deps] another apt holds the dpkg lock; waiting up to ${lock_timeout} s for it"
+fi
 echo "[deps] apt-get update ..."
-apt-get update -q
+apt-get -o DPkg::Lock::Timeout="$lock_timeout" update -q
 echo "[deps] apt-get install ..."
-DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}" \
+DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout="$lock_timeout" install -y -q \
+  --no-install-recommends "${missing[@]}" \
   | grep --line-buffered -E '^(Setting up|Unpacking|E:)' || true
 for package in "${missing[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then

@@ -41,7 +41,16 @@ Result<std::vector<double>> Numbers(const TiXmlElement& element, const char* nam
     const double value = std::strtod(cursor, &end);
     const bool out_of_range = errno == ERANGE;
     const std::string field = where + " " + name + "=" + Quoted(text);
-    if (end == cursor) return Result<std::vector<double>>::Error(field + " is not a number");
+    if (end == cursor) {
+      const std::string value = text;
+      const bool xacro =
+          value.find("${") != std::string::npos || value.find("$(") != std::string::npos;
+      return Result<std::vector<double>>::Error(
+          field + " is not a number" +
+          (xacro ? " (an unexpanded xacro expression: the description is xacro without the xacro "
+                   "namespace; declare xmlns:xacro or expand it with xacro)"
+                 : ""));
+    }
     const std::string number(cursor, static_cast<std::size_t>(end - cursor));
     // strtod flags a result too small for a normal double (a subnormal, or
     // 0) as ERANGE too: it is finite, but not the number written.
@@ -395,11 +404,12 @@ bool IsStaticDocument(const TiXmlElement& robot, const UrdfLoadOptions& options)
 }
 
 // The movable joints of a model that will move as an articulation (not
-// spawned static, not welded, not all massless): its step costs about n^3
+// welded, not all massless): its step costs about n^3
 // in them (docs/limits.md), so their count is a limit of its own.
 Status CheckMovableJointCount(const TiXmlElement& robot, const UrdfLoadOptions& options) {
-  if (!options.articulate || options.spawn_static || options.weld_movable_joints ||
-      EveryLinkIsMassless(robot)) {
+  // Spawned static, an articulated model keeps its joints (its base is
+  // fixed), so only welding or having no mass at all exempts it.
+  if (!options.articulate || options.weld_movable_joints || EveryLinkIsMassless(robot)) {
     return Status::Ok();
   }
   int movable = 0;
@@ -528,6 +538,33 @@ Status CheckMimicJoints(const urdf::ModelInterface& model) {
     }
   }
   return Status::Ok();
+}
+
+std::vector<std::string> IgnoredElements(const TiXmlElement& robot) {
+  std::vector<std::string> ignored;
+  const auto attribute = [](const TiXmlElement& element, const char* name) {
+    const char* value = element.Attribute(name);
+    return std::string(value == nullptr ? "" : value);
+  };
+  for (const TiXmlElement* transmission = robot.FirstChildElement("transmission");
+       transmission != nullptr; transmission = transmission->NextSiblingElement("transmission")) {
+    ignored.push_back("<transmission " + Quoted(attribute(*transmission, "name")) + ">");
+  }
+  for (const TiXmlElement* gazebo = robot.FirstChildElement("gazebo"); gazebo != nullptr;
+       gazebo = gazebo->NextSiblingElement("gazebo")) {
+    for (const TiXmlElement* plugin = gazebo->FirstChildElement("plugin"); plugin != nullptr;
+         plugin = plugin->NextSiblingElement("plugin")) {
+      ignored.push_back("<gazebo> plugin " + Quoted(attribute(*plugin, "name")) + " (" +
+                        attribute(*plugin, "filename") + ")");
+    }
+    for (const TiXmlElement* sensor = gazebo->FirstChildElement("sensor"); sensor != nullptr;
+         sensor = sensor->NextSiblingElement("sensor")) {
+      ignored.push_back("<gazebo reference=" + Quoted(attribute(*gazebo, "reference")) +
+                        "> sensor " + Quoted(attribute(*sensor, "name")) + " (" +
+                        attribute(*sensor, "type") + ")");
+    }
+  }
+  return ignored;
 }
 
 }  // namespace rigid_body_sim::io

@@ -1,5 +1,7 @@
 #include "rigid_body_sim/io/urdf_loader.h"
 
+#include "rigid_body_sim/io/xacro_process.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -71,6 +73,7 @@ class ModelBuilder {
     Result<MeshCollisionModes> modes = ReadMeshCollisionModes(*robot);
     if (!modes.ok()) return modes.status();
     mesh_modes_ = std::move(modes).value();
+    ignored_ = IgnoredElements(*robot);
 
     // urdfdom's reading of the document, with the products of inertia a
     // description left out written in as 0.
@@ -126,8 +129,10 @@ class ModelBuilder {
     LoadedModel loaded;
     loaded.name = model.getName();
     loaded.warnings = document_warnings_;
+    loaded.ignored = ignored_;
     urdf::LinkConstSharedPtr body_root = model.getRoot();
     if (body_root->name == kWorldLink) {
+      loaded.world_link = true;
       if (body_root->child_links.size() != 1) {
         return Result<LoadedModel>::Error("link 'world' must have exactly one child link, has " +
                                           std::to_string(body_root->child_links.size()));
@@ -174,7 +179,8 @@ class ModelBuilder {
                                         " has no <collision> elements");
     }
     loaded.mass_properties = physics::CombineMassProperties(parts_in_root);
-    if (!loaded.is_static) {
+    // A static model needs no mass: a bin of triangle meshes has none.
+    if (!loaded.is_static && !static_model_) {
       const Status mass_status = physics::ValidateMassProperties(loaded.mass_properties);
       if (!mass_status.ok()) {
         return Result<LoadedModel>::Error("model " + Quoted(loaded.name) +
@@ -526,6 +532,7 @@ class ModelBuilder {
   bool static_model_ = false;                   // fixed to `world`, massless, or spawned static
   bool massless_ = false;                       // every link states mass 0
   std::vector<std::string> document_warnings_;  // what reading the XML itself changed
+  std::vector<std::string> ignored_;            // IgnoredElements of the document
   UrdfMeshes meshes_;
 };
 
@@ -553,12 +560,26 @@ UriResolver ResolverOrDefault(const UrdfLoadOptions& options) {
   return options.resolver ? options.resolver : UriResolver(ResolveFileUri);
 }
 
+// The URDF of a description: itself, or what the xacro expander makes of it.
+Result<std::string> Expanded(const std::string& path, const std::string& text,
+                             const UrdfLoadOptions& options) {
+  if (!LooksLikeXacro(path, text)) return text;
+  if (!options.xacro_expander) {
+    return Result<std::string>::Error(
+        "the description is xacro (a .xacro file or the xacro namespace); this load takes URDF "
+        "only");
+  }
+  return options.xacro_expander(path, path.empty() ? text : std::string());
+}
+
 }  // namespace
 
 Result<LoadedModel> LoadUrdfString(const std::string& xml, const UrdfLoadOptions& options) {
   const Status status = ValidateOptions(options);
   if (!status.ok()) return status;
-  return ModelBuilder(options, ResolverOrDefault(options)).Build(xml);
+  const Result<std::string> urdf = Expanded("", xml, options);
+  if (!urdf.ok()) return urdf.status();
+  return ModelBuilder(options, ResolverOrDefault(options)).Build(*urdf);
 }
 
 Result<LoadedModel> LoadUrdfFile(const std::string& path, const UrdfLoadOptions& options) {
@@ -591,7 +612,10 @@ Result<LoadedModel> LoadUrdfFile(const std::string& path, const UrdfLoadOptions&
     if (!resolved.ok() || std::filesystem::path(*resolved).is_absolute()) return resolved;
     return (directory / *resolved).string();
   };
-  Result<LoadedModel> model = ModelBuilder(options, relative_to_file).Build(contents.str());
+  const Result<std::string> urdf = Expanded(path, contents.str(), options);
+  if (!urdf.ok())
+    return Result<LoadedModel>::Error("URDF file " + Quoted(path) + ": " + urdf.message());
+  Result<LoadedModel> model = ModelBuilder(options, relative_to_file).Build(*urdf);
   if (!model.ok()) {
     return Result<LoadedModel>::Error("URDF file " + Quoted(path) + ": " + model.message());
   }

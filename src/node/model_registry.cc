@@ -1,5 +1,6 @@
 #include "rigid_body_sim/node/model_registry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -53,7 +54,10 @@ Result<BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
   }
   BodyDef def;
   def.is_static = spec.is_static || model.is_static;
-  def.world_from_body = spec.root_state.world_from_frame;
+  // The spawn pose is the URDF's `world` frame, as in Gazebo and
+  // robot_state_publisher: a root fixed (or floating) to it sits at the
+  // joint's <origin> from there.
+  def.world_from_body = spec.root_state.world_from_frame * model.world_from_root;
   if (!def.is_static) {
     def.linear_velocity = spec.root_state.linear_velocity;
     def.angular_velocity = spec.root_state.angular_velocity;
@@ -89,7 +93,7 @@ Result<physics::ArticulationDef> MakeArticulationSpec(const io::LoadedModel& mod
   physics::ArticulationDef def = std::move(made).value();
   // MakeArticulationDef fixes a base without mass; a static spawn fixes any.
   def.fixed_base = def.fixed_base || spec.is_static;
-  def.world_from_base = spec.root_state.world_from_frame;
+  def.world_from_base = spec.root_state.world_from_frame * model.world_from_root;
   def.base_linear_velocity = def.fixed_base ? Vec3::Zero() : spec.root_state.linear_velocity;
   def.base_angular_velocity = def.fixed_base ? Vec3::Zero() : spec.root_state.angular_velocity;
   def.self_collide = spec.self_collide;
@@ -117,6 +121,55 @@ FrameState RootStateFromLink(const FrameState& link, const Pose& root_from_link)
 
 std::string FrameName(const std::string& model, const std::string& link) {
   return model + names::kFrameSeparator + link;
+}
+
+std::string TfFrame(const Model& model, const std::string& link) { return model.tf_prefix + link; }
+
+namespace {
+
+bool IsLetter(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
+
+}  // namespace
+
+Result<std::string> ResolveRobotNamespace(const std::string& robot_namespace) {
+  if (robot_namespace.empty() || robot_namespace == "/") return robot_namespace;
+  std::string resolved = robot_namespace.front() == '/' ? robot_namespace : "/" + robot_namespace;
+  if (resolved.back() == '/') resolved.pop_back();
+  // Segments [A-Za-z][A-Za-z0-9_]*, as ROS graph names.
+  bool segment_start = true;
+  for (std::size_t i = 1; i < resolved.size(); ++i) {
+    const char c = resolved[i];
+    const bool ok = c == '/' ? !segment_start : (segment_start ? IsLetter(c) : IsNameChar(c));
+    if (!ok) {
+      return Result<std::string>::Error("robot_namespace '" + robot_namespace +
+                                        "' is not a ROS namespace: each part must match "
+                                        "[A-Za-z][A-Za-z0-9_]*");
+    }
+    segment_start = c == '/';
+  }
+  return resolved;
+}
+
+Result<std::string> ResolveTfPrefix(const std::string& name, const std::string& tf_prefix) {
+  if (tf_prefix.empty()) return name + names::kFrameSeparator;
+  if (tf_prefix == "/") return std::string();
+  const bool allowed =
+      tf_prefix.front() != '/' && std::all_of(tf_prefix.begin(), tf_prefix.end(), [](char c) {
+        return IsNameChar(c) || c == '/' || c == '.' || c == '-';
+      });
+  if (!allowed) {
+    return Result<std::string>::Error("tf_prefix '" + tf_prefix +
+                                      "' may hold only [A-Za-z0-9_./-] and not start with '/' "
+                                      "('/' alone: no prefix)");
+  }
+  return tf_prefix;
+}
+
+Result<TfMode> TfModeFromName(const std::string& mode) {
+  if (mode.empty() || mode == "links") return TfMode::kLinks;
+  if (mode == "root") return TfMode::kRoot;
+  if (mode == "none") return TfMode::kNone;
+  return Result<TfMode>::Error("tf_mode '" + mode + "' is not one of links, root and none");
 }
 
 Status ModelRegistry::Add(Model model) {

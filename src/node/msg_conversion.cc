@@ -112,6 +112,13 @@ Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request
   spec.friction = request.friction;
   spec.restitution = request.restitution;
   spec.self_collide = request.self_collide;
+  spec.robot_namespace = request.robot_namespace;
+  spec.tf_prefix = request.tf_prefix;
+  Result<TfMode> tf_mode = TfModeFromName(request.tf_mode);
+  if (!tf_mode.ok()) return tf_mode.status();
+  spec.tf_mode = *tf_mode;
+  spec.hold = request.hold;
+  spec.xacro_args = request.xacro_args;
   if (request.joint_positions.size() != request.joint_names.size()) {
     return Result<ModelSpec>::Error(
         "joint_positions has " + std::to_string(request.joint_positions.size()) + " values for " +

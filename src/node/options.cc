@@ -101,9 +101,9 @@ Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
   if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     return Status::Error(what + " must be a dictionary");
   }
-  static const std::set<std::string> kKeys = {"name",     "urdf",        "urdf_path",
-                                              "pose",     "twist",       "is_static",
-                                              "friction", "restitution", "joints"};
+  static const std::set<std::string> kKeys = {
+      "name",        "urdf",   "urdf_path",       "pose",      "twist",   "is_static", "friction",
+      "restitution", "joints", "robot_namespace", "tf_prefix", "tf_mode", "hold"};
   for (auto& [key, unused] : entry) {
     if (kKeys.count(key) == 0) return Status::Error(what + " has an unknown field '" + key + "'");
   }
@@ -118,8 +118,20 @@ Status ReadModel(XmlRpc::XmlRpcValue& entry, int index, ModelSpec* spec) {
         read_field("is_static", ReadBool, &spec->is_static),
         read_field("friction", ReadDouble, &spec->friction),
         read_field("restitution", ReadDouble, &spec->restitution),
-        read_field("joints", ReadJoints, &spec->joint_positions)}) {
+        read_field("joints", ReadJoints, &spec->joint_positions),
+        read_field("robot_namespace", ReadString, &spec->robot_namespace),
+        read_field("tf_prefix", ReadString, &spec->tf_prefix),
+        read_field("hold", ReadBool, &spec->hold)}) {
     if (!status.ok()) return status;
+  }
+  if (entry.hasMember("tf_mode")) {
+    std::string mode;
+    if (Status status = ReadString(entry["tf_mode"], what + ".tf_mode", &mode); !status.ok()) {
+      return status;
+    }
+    Result<TfMode> tf_mode = TfModeFromName(mode);
+    if (!tf_mode.ok()) return Status::Error(what + ": " + tf_mode.message());
+    spec->tf_mode = *tf_mode;
   }
   std::vector<double> values;
   if (entry.hasMember("pose")) {
@@ -234,6 +246,52 @@ std::vector<std::string> LiveSettingsWarnings(const LiveSettings& settings,
   return warnings;
 }
 
+namespace {
+
+// The size and process limits, and the joint servo's gains.
+Status ValidateLimitOptions(const NodeOptions& options) {
+  // The articulation holds at most 1000 links (physics/world_articulations.cc).
+  const struct {
+    const char* name;
+    double value;
+    double low;
+    double high;
+    const char* unit;
+  } kRanges[] = {
+      {"~max_links_per_model", static_cast<double>(options.max_links_per_model), 1, 1e9, ""},
+      {"~max_joints_per_model", static_cast<double>(options.max_joints_per_model), 1, 999, ""},
+      {"~max_mesh_triangles", static_cast<double>(options.max_mesh_triangles), 1,
+       static_cast<double>(physics::CollisionMesh::kMaxTriangles), ""},
+      {"~max_file_bytes", static_cast<double>(options.max_file_bytes), 1, 2147483647.0, "bytes"},
+      {"~mesh_memory_limit", static_cast<double>(options.mesh_memory_limit), 16777216.0,
+       2147483647.0, "bytes"},
+  };
+  for (const auto& range : kRanges) {
+    if (Status status = CheckRange(range.name, range.value, range.low, range.high, range.unit);
+        !status.ok()) {
+      return status;
+    }
+  }
+  // The servo is implicit, so any gain is stable; the bound keeps dt k
+  // (and so the soft row's terms) far from overflow.
+  constexpr double kMaxServoGain = 1e12;
+  if (!(options.servo.stiffness > 0.0 && options.servo.stiffness <= kMaxServoGain)) {
+    return Status::Error("~joint_stiffness " + FormatNumber(options.servo.stiffness) +
+                         " is outside the allowed range (0, 1e12] N m/rad");
+  }
+  if (!(options.servo.damping >= 0.0 && options.servo.damping <= kMaxServoGain)) {
+    return Status::Error("~joint_damping " + FormatNumber(options.servo.damping) +
+                         " is outside the allowed range [0, 1e12] N m s/rad");
+  }
+  if (!(options.mesh_cpu_limit > 0.0 && options.mesh_cpu_limit <= 3600.0)) {
+    return Status::Error("~mesh_cpu_limit " + FormatNumber(options.mesh_cpu_limit) +
+                         " s is outside the allowed range (0, 3600] s");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status ValidateNodeOptions(const NodeOptions& options) {
   if (options.world_frame.empty()) return Status::Error("~world_frame is empty");
   if (options.world_frame.front() == '/') {
@@ -247,43 +305,7 @@ Status ValidateNodeOptions(const NodeOptions& options) {
         ValidateRequestLimits(options.limits)}) {
     if (!status.ok()) return status;
   }
-  if (options.max_links_per_model < 1) {
-    return Status::Error("~max_links_per_model " + std::to_string(options.max_links_per_model) +
-                         " must be >= 1");
-  }
-  // The articulation holds at most 1000 links (physics/world_articulations.cc).
-  if (Status status = CheckRange("~max_joints_per_model", options.max_joints_per_model, 1, 999, "");
-      !status.ok()) {
-    return status;
-  }
-  // The servo is implicit, so any gain is stable; the bound keeps dt k
-  // (and so the soft row's terms) far from overflow.
-  constexpr double kMaxServoGain = 1e12;
-  if (!(options.servo.stiffness > 0.0 && options.servo.stiffness <= kMaxServoGain)) {
-    return Status::Error("~joint_stiffness " + FormatNumber(options.servo.stiffness) +
-                         " is outside the allowed range (0, 1e12] N m/rad");
-  }
-  if (!(options.servo.damping >= 0.0 && options.servo.damping <= kMaxServoGain)) {
-    return Status::Error("~joint_damping " + FormatNumber(options.servo.damping) +
-                         " is outside the allowed range [0, 1e12] N m s/rad");
-  }
-  if (options.mesh_memory_limit < (1 << 24)) {
-    return Status::Error("~mesh_memory_limit " + std::to_string(options.mesh_memory_limit) +
-                         " bytes is below the allowed 16777216");
-  }
-  if (!(options.mesh_cpu_limit > 0.0 && options.mesh_cpu_limit <= 3600.0)) {
-    return Status::Error("~mesh_cpu_limit " + FormatNumber(options.mesh_cpu_limit) +
-                         " s is outside the allowed range (0, 3600] s");
-  }
-  if (Status status = CheckRange("~max_mesh_triangles", options.max_mesh_triangles, 1,
-                                 static_cast<double>(physics::CollisionMesh::kMaxTriangles), "");
-      !status.ok()) {
-    return status;
-  }
-  if (options.max_file_bytes < 1) {
-    return Status::Error("~max_file_bytes " + std::to_string(options.max_file_bytes) +
-                         " must be >= 1");
-  }
+  if (Status status = ValidateLimitOptions(options); !status.ok()) return status;
   if (Status status = CheckRange("~threads", options.world.threads, 0, physics::kMaxThreads, "");
       !status.ok()) {
     return status;

@@ -80,6 +80,12 @@ Status ValidateFrameState(const FrameState& state, const RequestLimits& limits) 
 
 Status ValidateModelSpec(const ModelSpec& spec, const RequestLimits& limits) {
   if (Status status = ValidateFrameState(spec.root_state, limits); !status.ok()) return status;
+  if (Status status = ResolveRobotNamespace(spec.robot_namespace).status(); !status.ok()) {
+    return status;
+  }
+  if (Status status = ResolveTfPrefix(spec.name, spec.tf_prefix).status(); !status.ok()) {
+    return status;
+  }
   // Negative means "not set"; NaN is neither.
   if (std::isnan(spec.friction) || spec.friction > kMaxFriction) {
     return Status::Error("friction " + FormatNumber(spec.friction) +

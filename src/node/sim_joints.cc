@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,10 @@ using physics::Status;
 
 void SimNode::AdvertiseJointTopicsLocked(const Model& model) {
   JointTopics topics;
-  topics.handle = ros::NodeHandle(private_node_, model.name);
+  // ~<model>/ by default; a robot namespace as Gazebo's robotNamespace,
+  // "/" for the global joint_states that robot_state_publisher reads.
+  topics.handle = model.robot_namespace.empty() ? ros::NodeHandle(private_node_, model.name)
+                                                : ros::NodeHandle(model.robot_namespace);
   topics.states = topics.handle.advertise<sensor_msgs::JointState>(names::kJointStatesTopic, 10);
   // The callbacks hold what they parse against, so they never read the
   // registry without the world lock.
@@ -72,15 +76,15 @@ void SimNode::OnJointCommand(const std::shared_ptr<const ModelJoints>& joints,
               commands.message().c_str());
     return;
   }
-  std::optional<ActiveTrajectory> replaced;  // freed after the lock is released
+  std::vector<int> named;
+  for (const auto& [joint, command] : *commands) named.push_back(joint);
+  std::vector<ActiveTrajectory> released;  // freed after the lock is released
   std::unique_lock<std::mutex> lock = LockWorld();
   if (!IsSameModelLocked(model_name, articulation)) return;
   const Model* model = registry_.Find(model_name);
-  // A command takes over from a trajectory in progress.
-  if (const auto found = trajectories_.find(model_name); found != trajectories_.end()) {
-    replaced = std::move(found->second);
-    trajectories_.erase(found);
-  }
+  // The command takes its joints over from any trajectory in progress; the
+  // trajectory keeps driving the others.
+  ReleaseJointsLocked(model_name, named, &released);
   for (const auto& [joint, command] : *commands) {
     const Status status = world_.SetJointCommand(model->articulation, joint, command);
     if (!status.ok()) ROS_ERROR("%s: %s", model_name.c_str(), status.message().c_str());
@@ -114,7 +118,9 @@ void SimNode::OnJointTrajectory(const std::shared_ptr<const ModelJoints>& joints
   Result<ParsedTrajectory> parsed =
       ParseJointTrajectory(*joints, JointTrajectoryFromMsg(message), options_.limits);
   if (!parsed.ok()) return refuse(parsed.message());
-  ActiveTrajectory active{std::move(parsed.value().joints), std::move(parsed.value().plan), 0.0};
+  ActiveTrajectory active{
+      std::move(parsed.value().joints), {}, std::move(parsed.value().plan), 0.0};
+  std::vector<ActiveTrajectory> released;  // freed after the lock is released
   std::unique_lock<std::mutex> lock = LockWorld();
   if (!IsSameModelLocked(model_name, articulation)) return;
   const Model* model = registry_.Find(model_name);
@@ -137,31 +143,61 @@ void SimNode::OnJointTrajectory(const std::shared_ptr<const ModelJoints>& joints
     start.velocities.push_back(states[joint].velocity);
   }
   if (Status status = active.plan.Begin(start); !status.ok()) return refuse(status.message());
-  // The one replaced is freed by `active` after the lock is released.
-  std::swap(trajectories_[model_name], active);
+  // It takes its joints over from the trajectories in progress, which keep
+  // the others (an arm's trajectory and a gripper's, as two controllers).
+  ReleaseJointsLocked(model_name, active.joints, &released);
+  active.owned.assign(active.joints.size(), true);
+  trajectories_[model_name].push_back(std::move(active));
+}
+
+void SimNode::ReleaseJointsLocked(const std::string& model_name, const std::vector<int>& joints,
+                                  std::vector<ActiveTrajectory>* released) {
+  const auto found = trajectories_.find(model_name);
+  if (found == trajectories_.end()) return;
+  std::vector<ActiveTrajectory>& running = found->second;
+  for (ActiveTrajectory& active : running) {
+    for (std::size_t k = 0; k < active.joints.size(); ++k) {
+      if (std::find(joints.begin(), joints.end(), active.joints[k]) != joints.end()) {
+        active.owned[k] = false;
+      }
+    }
+  }
+  const auto owns_none = [](const ActiveTrajectory& active) {
+    return std::none_of(active.owned.begin(), active.owned.end(), [](bool owned) { return owned; });
+  };
+  const auto first_done = std::stable_partition(
+      running.begin(), running.end(), [&](const ActiveTrajectory& a) { return !owns_none(a); });
+  std::move(first_done, running.end(), std::back_inserter(*released));
+  running.erase(first_done, running.end());
+  if (running.empty()) trajectories_.erase(found);
 }
 
 void SimNode::FollowTrajectoriesLocked() {
   const double end_of_step = world_.time() + world_.settings().time_step;
   for (auto it = trajectories_.begin(); it != trajectories_.end();) {
     const Model* model = registry_.Find(it->first);
-    const ActiveTrajectory& active = it->second;
-    const double t = end_of_step - active.start_time;
-    if (model == nullptr || t < 0.0) {
-      ++it;
-      continue;
+    std::vector<ActiveTrajectory>& running = it->second;
+    for (auto active = running.begin(); model != nullptr && active != running.end();) {
+      const double t = end_of_step - active->start_time;
+      if (t < 0.0) {
+        ++active;
+        continue;
+      }
+      const TrajectorySample sample = active->plan.Sample(t);
+      for (std::size_t k = 0; k < active->joints.size(); ++k) {
+        if (!active->owned[k]) continue;
+        JointCommand command;
+        command.mode = physics::JointCommandMode::kPosition;
+        command.position = sample.positions[k];
+        command.velocity = sample.velocities[k];
+        const Status status =
+            world_.SetJointCommand(model->articulation, active->joints[k], command);
+        assert(status.ok());
+      }
+      // Past its end the last servo commands hold the final point.
+      active = t > active->plan.duration() ? running.erase(active) : std::next(active);
     }
-    const TrajectorySample sample = active.plan.Sample(t);
-    for (std::size_t k = 0; k < active.joints.size(); ++k) {
-      JointCommand command;
-      command.mode = physics::JointCommandMode::kPosition;
-      command.position = sample.positions[k];
-      command.velocity = sample.velocities[k];
-      const Status status = world_.SetJointCommand(model->articulation, active.joints[k], command);
-      assert(status.ok());
-    }
-    // Past its end the last servo commands hold the final point.
-    it = t > active.plan.duration() ? trajectories_.erase(it) : std::next(it);
+    it = running.empty() ? trajectories_.erase(it) : std::next(it);
   }
 }
 
@@ -206,11 +242,16 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
                 std::to_string(request.positions.size()) + " and " +
                 std::to_string(request.velocities.size()));
   }
+  if (!request.name.empty() && !request.model.empty() && request.name != request.model) {
+    return fail("name '" + request.name + "' and model '" + request.model +
+                "' differ; give the model's name in name");
+  }
+  const std::string& model_name = request.name.empty() ? request.model : request.name;
   std::unique_lock<std::mutex> lock = LockWorld();
-  const Model* model = registry_.Find(request.model);
-  if (model == nullptr) return fail("no model named '" + request.model + "'");
+  const Model* model = registry_.Find(model_name);
+  if (model == nullptr) return fail("no model named '" + model_name + "'");
   if (!model->articulation.IsValid()) {
-    return fail("model '" + request.model + "' has no movable joints");
+    return fail("model '" + model_name + "' has no movable joints");
   }
   std::vector<double> positions;
   std::vector<double> velocities;
@@ -222,7 +263,7 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
     const std::string& name = request.joint_names[i];
     const auto found = std::find(model->joint_names.begin(), model->joint_names.end(), name);
     if (found == model->joint_names.end()) {
-      return fail("model '" + request.model + "' has no movable joint '" + name + "'");
+      return fail("model '" + model_name + "' has no movable joint '" + name + "'");
     }
     for (const io::JointInfo& info : model->joints) {
       if (info.name == name && !info.mimic_joint.empty()) {
@@ -250,7 +291,7 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
   const Status status = world_.SetJointStates(model->articulation, positions, velocities);
   if (!status.ok()) return fail(status.message());
   response.success = true;
-  response.message = "set " + std::to_string(count) + " joints of '" + request.model + "'";
+  response.message = "set " + std::to_string(count) + " joints of '" + model_name + "'";
   return true;
 }
 
@@ -261,8 +302,23 @@ Status SimNode::ResetJointsLocked(const Model& model) {
         world_.SetJointCommand(model.articulation, static_cast<int>(j), JointCommand());
     if (!status.ok()) return status;
   }
+  if (model.hold) HoldJointsLocked(model);
   return world_.SetJointStates(model.articulation, model.spawn_joint_positions,
                                std::vector<double>(model.spawn_joint_positions.size(), 0.0));
+}
+
+void SimNode::HoldJointsLocked(const Model& model) {
+  for (std::size_t j = 0; j < model.joint_names.size(); ++j) {
+    const bool mimic = std::any_of(model.joints.begin(), model.joints.end(), [&](const auto& info) {
+      return info.name == model.joint_names[j] && !info.mimic_joint.empty();
+    });
+    if (mimic) continue;
+    JointCommand hold;
+    hold.mode = physics::JointCommandMode::kPosition;
+    hold.position = model.spawn_joint_positions[j];
+    const Status status = world_.SetJointCommand(model.articulation, static_cast<int>(j), hold);
+    assert(status.ok());
+  }
 }
 
 }  // namespace rigid_body_sim::node

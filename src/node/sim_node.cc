@@ -16,6 +16,7 @@
 
 #include "node/ros_uri.h"
 #include "rigid_body_sim/io/mesh_process.h"
+#include "rigid_body_sim/io/xacro_process.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 
@@ -29,10 +30,11 @@ namespace {
 
 // The mesh helper is built next to the node (devel/lib/rigid_body_sim, or
 // the installed package's lib directory).
-std::string MeshHelperPath() {
+// A program installed beside the node (the mesh helper, the xacro expander).
+std::string BesideNode(const std::string& name) {
   std::error_code error;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
-  return (self.parent_path() / "rigid_body_sim_mesh_helper").string();
+  return (self.parent_path() / name).string();
 }
 
 }  // namespace
@@ -52,7 +54,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
   load_options_.max_file_bytes = static_cast<std::uintmax_t>(options_.max_file_bytes);
   // Meshes are untrusted files: assimp and qhull run in the helper process.
   io::MeshProcessLimits mesh_limits;
-  mesh_limits.helper_path = MeshHelperPath();
+  mesh_limits.helper_path = BesideNode("rigid_body_sim_mesh_helper");
   mesh_limits.memory_bytes = static_cast<std::uint64_t>(options_.mesh_memory_limit);
   mesh_limits.cpu_seconds = options_.mesh_cpu_limit;
   mesh_limits.max_file_bytes = static_cast<std::uint64_t>(options_.max_file_bytes);
@@ -171,9 +173,9 @@ Status SimNode::Start() {
   }
 
   for (const ModelSpec& spec : options_.models) {
-    Result<std::vector<std::string>> frames = SpawnModel(spec);
-    if (!frames.ok()) {
-      return Status::Error("~models: cannot spawn '" + spec.name + "': " + frames.message());
+    Result<SpawnedModel> spawned = SpawnModel(spec);
+    if (!spawned.ok()) {
+      return Status::Error("~models: cannot spawn '" + spec.name + "': " + spawned.message());
     }
   }
 
@@ -228,6 +230,15 @@ Result<io::LoadedModel> SimNode::LoadModel(const ModelSpec& spec) const {
                                           " bytes, more than ~max_file_bytes " +
                                           std::to_string(options.max_file_bytes));
   }
+  io::XacroRequest xacro;
+  xacro.script = BesideNode("xacro");
+  xacro.args = spec.xacro_args;
+  xacro.limits.memory_bytes = static_cast<std::uint64_t>(options_.mesh_memory_limit);
+  xacro.limits.cpu_seconds = options_.mesh_cpu_limit;
+  xacro.limits.max_file_bytes = static_cast<std::uint64_t>(options_.max_file_bytes);
+  options.xacro_expander = [xacro](const std::string& path, const std::string& text) {
+    return path.empty() ? io::ExpandXacroText(text, xacro) : io::ExpandXacroFile(path, xacro);
+  };
   if (!spec.urdf.empty()) return io::LoadUrdfString(spec.urdf, options);
   if (spec.urdf_path.empty()) {
     return Result<io::LoadedModel>::Error("neither urdf nor urdf_path is given");
@@ -242,17 +253,17 @@ namespace {
 // The collision shapes of a model being spawned: for an articulated one, a
 // marker per shape in its link's frame, ids running on across the links so
 // that none replaces another; else the body's shapes in its root frame.
-std::vector<visualization_msgs::Marker> SpawnMarkers(const std::string& name,
+std::vector<visualization_msgs::Marker> SpawnMarkers(const Model& model,
                                                      const io::LoadedModel& loaded,
                                                      const physics::BodyDef& def,
                                                      const physics::ArticulationDef* articulation) {
   if (articulation == nullptr) {
-    return ShapeMarkers(def.shapes, name, FrameName(name, loaded.root_link));
+    return ShapeMarkers(def.shapes, model.name, TfFrame(model, loaded.root_link));
   }
   std::vector<visualization_msgs::Marker> markers;
   for (const physics::LinkDef& link : articulation->links) {
     for (visualization_msgs::Marker& marker :
-         ShapeMarkers(link.shapes, name, FrameName(name, link.name))) {
+         ShapeMarkers(link.shapes, model.name, TfFrame(model, link.name))) {
       marker.id = static_cast<int>(markers.size());
       markers.push_back(std::move(marker));
     }
@@ -262,78 +273,132 @@ std::vector<visualization_msgs::Marker> SpawnMarkers(const std::string& name,
 
 }  // namespace
 
-Result<std::vector<std::string>> SimNode::SpawnModel(const ModelSpec& spec) {
-  using FramesResult = Result<std::vector<std::string>>;
+// Load, convert, commit, announce: the model is read and turned into its
+// definitions before the world is locked, added under the lock, and its
+// messages go out after.
+Result<SimNode::SpawnedModel> SimNode::SpawnModel(const ModelSpec& spec) {
   if (Status status = ValidateModelName(spec.name); !status.ok()) return status;
   MaterialDefaults defaults;
   {
     // Early refusal of a taken name spares loading the model; the name is
     // checked again when the body is added.
     std::unique_lock<std::mutex> lock = LockWorld();
-    if (registry_.Find(spec.name) != nullptr) {
-      return FramesResult::Error("a model named '" + spec.name + "' already exists");
-    }
+    if (Status status = CheckNamesFreeLocked(spec); !status.ok()) return status;
     defaults = live_.defaults;
   }
-  Result<io::LoadedModel> loaded = LoadModel(spec);
-  if (!loaded.ok()) return loaded.status();
-  std::vector<std::string> warnings = loaded->warnings;
-  Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, defaults);
-  if (!def.ok()) return def.status();
-  std::optional<physics::ArticulationDef> articulation;
-  if (loaded->articulated) {
-    Result<physics::ArticulationDef> made =
-        MakeArticulationSpec(*loaded, spec, defaults, &warnings);
-    if (!made.ok()) return made.status();
-    articulation = std::move(made).value();
-  }
-
-  // The markers hold every triangle of a static mesh (6 M points for a
-  // 2 M-triangle terrain): built and copied before the world is locked.
-  std::vector<visualization_msgs::Marker> markers =
-      SpawnMarkers(spec.name, *loaded, *def, articulation ? &*articulation : nullptr);
+  Result<PreparedModel> prepared = PrepareModel(spec, defaults);
+  if (!prepared.ok()) return prepared.status();
   Outbox outbox;
-  outbox.body_markers.emplace().markers = markers;
+  outbox.body_markers.emplace().markers = prepared->markers;
   std::vector<std::string> frames;
   {
     std::unique_lock<std::mutex> lock = LockWorld();
-    if (registry_.Find(spec.name) != nullptr) {
-      return FramesResult::Error("a model named '" + spec.name + "' already exists");
-    }
-    Model model;
-    model.name = spec.name;
-    const Status created = articulation ? CreateArticulationLocked(*articulation, *loaded, &model)
-                                        : CreateBodyLocked(*def, *loaded, &model);
-    if (!created.ok()) return created;
-    model.links = loaded->links;
-    model.joints = loaded->joints;
-    model.mass = def->is_static ? 0.0 : def->mass_properties.mass;
-    model.spawn_state =
-        FrameState{def->world_from_body, def->linear_velocity, def->angular_velocity};
-    for (const io::LinkFrame& link : model.links) {
-      frames.push_back(FrameName(spec.name, link.link_name));
-    }
-    body_markers_[spec.name] =
-        std::make_shared<const std::vector<visualization_msgs::Marker>>(std::move(markers));
-    const Status added = registry_.Add(std::move(model));
-    assert(added.ok());
-    const Model& stored = *registry_.Find(spec.name);
-    if (stored.is_static || stored.articulation.IsValid()) outbox.tf_static = StaticTfLocked();
-    if (!stored.is_static) {
-      outbox.tf = ModelTfLocked(stored);
-      outbox.tf_is_new_frame = true;
-      outbox.reset_count = reset_count_;
-    }
+    Result<std::vector<std::string>> committed =
+        CommitModelLocked(spec, &prepared.value(), &outbox);
+    if (!committed.ok()) return committed.status();
+    frames = std::move(committed).value();
   }
   Publish(std::move(outbox));
-  for (const std::string& warning : warnings) {
+  for (const std::string& warning : prepared->warnings) {
     ROS_WARN("model '%s': %s", spec.name.c_str(), warning.c_str());
   }
+  const PreparedModel& made = *prepared;
   ROS_INFO("spawned '%s' (%s, %zu shapes, %zu frames)", spec.name.c_str(),
-           articulation ? (articulation->fixed_base ? "articulated, fixed base"
-                                                    : "articulated, floating base")
-                        : (def->is_static ? "static" : "dynamic"),
-           def->shapes.size(), frames.size());
+           made.articulation ? (made.articulation->fixed_base ? "articulated, fixed base"
+                                                              : "articulated, floating base")
+                             : (made.def.is_static ? "static" : "dynamic"),
+           made.def.shapes.size(), frames.size());
+  return SpawnedModel{std::move(frames), made.loaded.ignored};
+}
+
+Status SimNode::CheckNamesFreeLocked(const ModelSpec& spec) const {
+  if (registry_.Find(spec.name) != nullptr) {
+    return Status::Error("a model named '" + spec.name + "' already exists");
+  }
+  const Result<std::string> robot_namespace = ResolveRobotNamespace(spec.robot_namespace);
+  if (!robot_namespace.ok()) return robot_namespace.status();
+  if (robot_namespace->empty()) return Status::Ok();
+  // Two models' joint topics in one namespace would read each other's
+  // commands and interleave their joint_states.
+  for (const auto& [name, model] : registry_.models()) {
+    if (model.robot_namespace == *robot_namespace) {
+      return Status::Error("robot_namespace '" + *robot_namespace + "' is taken by model '" + name +
+                           "'");
+    }
+  }
+  return Status::Ok();
+}
+
+Result<SimNode::PreparedModel> SimNode::PrepareModel(const ModelSpec& spec,
+                                                     const MaterialDefaults& defaults) const {
+  Result<io::LoadedModel> loaded = LoadModel(spec);
+  if (!loaded.ok()) return loaded.status();
+  PreparedModel prepared;
+  prepared.warnings = loaded->warnings;
+  Result<physics::BodyDef> def = MakeBodyDef(*loaded, spec, defaults);
+  if (!def.ok()) return def.status();
+  prepared.def = std::move(def).value();
+  if (loaded->articulated) {
+    Result<physics::ArticulationDef> made =
+        MakeArticulationSpec(*loaded, spec, defaults, &prepared.warnings);
+    if (!made.ok()) return made.status();
+    prepared.articulation = std::move(made).value();
+  }
+  prepared.model.name = spec.name;
+  prepared.model.robot_namespace = ResolveRobotNamespace(spec.robot_namespace).value();
+  prepared.model.tf_prefix = ResolveTfPrefix(spec.name, spec.tf_prefix).value();
+  prepared.model.tf_mode = spec.tf_mode;
+  prepared.model.hold = spec.hold;
+  prepared.model.world_link = loaded->world_link;
+  if (loaded->world_link && spec.tf_mode == TfMode::kRoot &&
+      !(spec.root_state.world_from_frame.translation.isZero() &&
+        spec.root_state.world_from_frame.rotation.isApprox(physics::Quat::Identity(), 0.0))) {
+    prepared.warnings.push_back(
+        "tf_mode root: robot_state_publisher places the links from the URDF's 'world' link, "
+        "which tf takes as the world frame, while the model was spawned away from it; spawn it "
+        "at the identity pose, or give the URDF no 'world' link");
+  }
+  prepared.model.links = loaded->links;
+  prepared.model.joints = loaded->joints;
+  // An arm fixed to the world moves all the same: its mass is its links'.
+  prepared.model.mass = prepared.def.is_static ? 0.0 : prepared.def.mass_properties.mass;
+  if (prepared.articulation) {
+    prepared.model.mass = 0.0;
+    for (const io::LinkFrame& link : loaded->links) prepared.model.mass += link.mass;
+  }
+  prepared.model.spawn_state = FrameState{
+      prepared.def.world_from_body, prepared.def.linear_velocity, prepared.def.angular_velocity};
+  // The markers hold every triangle of a static mesh (6 M points for a
+  // 2 M-triangle terrain): built before the world is locked.
+  prepared.markers = SpawnMarkers(prepared.model, *loaded, prepared.def,
+                                  prepared.articulation ? &*prepared.articulation : nullptr);
+  prepared.loaded = std::move(loaded).value();
+  return prepared;
+}
+
+Result<std::vector<std::string>> SimNode::CommitModelLocked(const ModelSpec& spec,
+                                                            PreparedModel* prepared,
+                                                            Outbox* outbox) {
+  if (Status status = CheckNamesFreeLocked(spec); !status.ok()) return status;
+  Model model = prepared->model;
+  const Status created =
+      prepared->articulation
+          ? CreateArticulationLocked(*prepared->articulation, prepared->loaded, &model)
+          : CreateBodyLocked(prepared->def, prepared->loaded, &model);
+  if (!created.ok()) return created;
+  std::vector<std::string> frames;
+  for (const io::LinkFrame& link : model.links) frames.push_back(TfFrame(model, link.link_name));
+  body_markers_[spec.name] =
+      std::make_shared<const std::vector<visualization_msgs::Marker>>(std::move(prepared->markers));
+  const Status added = registry_.Add(std::move(model));
+  assert(added.ok());
+  const Model& stored = *registry_.Find(spec.name);
+  if (stored.is_static || stored.articulation.IsValid()) outbox->tf_static = StaticTfLocked();
+  if (!stored.is_static) {
+    outbox->tf = ModelTfLocked(stored);
+    outbox->tf_is_new_frame = true;
+    outbox->reset_count = reset_count_;
+  }
   return frames;
 }
 
@@ -391,6 +456,7 @@ Status SimNode::CreateArticulationLocked(const physics::ArticulationDef& def,
     model->body_from_link.push_back(
         frame_of_link.at(def.links[group].name)->root_from_link.Inverse() * link.root_from_link);
   }
+  if (model->hold) HoldJointsLocked(*model);
   AdvertiseJointTopicsLocked(*model);
   return Status::Ok();
 }

@@ -38,14 +38,21 @@ bool SimNode::OnSpawn(rigid_body_sim::Spawn::Request& request,
   if (Status status = ValidateModelSpec(*spec, options_.limits); !status.ok()) {
     return Fail(response, status.message(), names::kSpawnService);
   }
-  Result<std::vector<std::string>> frames = SpawnModel(*spec);
-  if (!frames.ok()) {
-    return Fail(response, "cannot spawn '" + request.name + "': " + frames.message(),
+  Result<SpawnedModel> spawned = SpawnModel(*spec);
+  if (!spawned.ok()) {
+    return Fail(response, "cannot spawn '" + request.name + "': " + spawned.message(),
                 names::kSpawnService);
   }
   response.success = true;
   response.message = "spawned '" + request.name + "'" + DescribeOverlaps(request.name);
-  response.frames = *frames;
+  // Said once, in the reply: what the description asks for that does not
+  // run here (a Gazebo user's controllers, plugins and sensors).
+  std::string ignored;
+  for (const std::string& element : spawned->ignored) {
+    ignored += (ignored.empty() ? "; ignored (not simulated): " : ", ") + element;
+  }
+  response.message += ignored;
+  response.frames = spawned->frames;
   return true;
 }
 

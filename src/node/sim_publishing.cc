@@ -41,20 +41,28 @@ std::size_t LinkIndex(const Model& model, const std::string& link_name) {
 
 // A rigid model: every link frame from the world frame. An articulated one
 // follows the URDF tree: the world to its root link, then each movable
-// joint's parent link to its child link (its fixed joints are static).
+// joint's parent link to its child link (its fixed joints are static). In
+// TfMode::kRoot only the world to the root link, in kNone nothing.
 void SimNode::AppendModelTfLocked(const Model& model, const ros::Time& stamp,
                                   tf2_msgs::TFMessage* tf) const {
-  if (!model.articulation.IsValid()) {
-    for (std::size_t i = 0; i < model.links.size(); ++i) {
-      tf->transforms.push_back(
-          TransformToMsg(LinkStateLocked(model, i).world_from_frame, options_.world_frame,
-                         FrameName(model.name, model.links[i].link_name), stamp));
-    }
+  if (model.tf_mode == TfMode::kNone) return;
+  const auto from_world = [&](std::size_t link) {
+    tf->transforms.push_back(TransformToMsg(LinkStateLocked(model, link).world_from_frame,
+                                            options_.world_frame,
+                                            TfFrame(model, model.links[link].link_name), stamp));
+  };
+  if (model.tf_mode == TfMode::kRoot) {
+    // A root fixed to the URDF's `world` link: robot_state_publisher
+    // publishes world -> root from the URDF; a second parent would split
+    // the tree.
+    if (!model.world_link) from_world(0);
     return;
   }
-  tf->transforms.push_back(TransformToMsg(LinkStateLocked(model, 0).world_from_frame,
-                                          options_.world_frame,
-                                          FrameName(model.name, model.links[0].link_name), stamp));
+  if (!model.articulation.IsValid()) {
+    for (std::size_t i = 0; i < model.links.size(); ++i) from_world(i);
+    return;
+  }
+  from_world(0);
   for (const io::JointInfo& joint : model.joints) {
     if (joint.type == "fixed") continue;
     const physics::Pose world_from_parent =
@@ -62,8 +70,8 @@ void SimNode::AppendModelTfLocked(const Model& model, const ros::Time& stamp,
     const physics::Pose world_from_child =
         LinkStateLocked(model, LinkIndex(model, joint.child_link)).world_from_frame;
     tf->transforms.push_back(TransformToMsg(world_from_parent.Inverse() * world_from_child,
-                                            FrameName(model.name, joint.parent_link),
-                                            FrameName(model.name, joint.child_link), stamp));
+                                            TfFrame(model, joint.parent_link),
+                                            TfFrame(model, joint.child_link), stamp));
   }
 }
 
@@ -79,7 +87,7 @@ tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
   const ros::Time stamp = StampLocked();
   for (const auto& [name, model] : registry_.models()) {
     if (model.is_static) AppendModelTfLocked(model, stamp, &tf);
-    if (!model.articulation.IsValid()) continue;
+    if (!model.articulation.IsValid() || model.tf_mode != TfMode::kLinks) continue;
     for (const io::JointInfo& joint : model.joints) {
       if (joint.type != "fixed") continue;
       const physics::Pose& root_from_parent =
@@ -87,8 +95,8 @@ tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
       const physics::Pose& root_from_child =
           model.links[LinkIndex(model, joint.child_link)].root_from_link;
       tf.transforms.push_back(TransformToMsg(root_from_parent.Inverse() * root_from_child,
-                                             FrameName(name, joint.parent_link),
-                                             FrameName(name, joint.child_link), stamp));
+                                             TfFrame(model, joint.parent_link),
+                                             TfFrame(model, joint.child_link), stamp));
     }
   }
   return tf;

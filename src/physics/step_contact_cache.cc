@@ -17,7 +17,10 @@ void WorldImpl::UpdateContactCache() {
   for (const ShapePairContact* pair : contact_cache_.touching()) {
     Body& a = bodies_[pair->body_a];
     Body& b = bodies_[pair->body_b];
+    // Either side may be the sleeper: a link closing on a box that sleeps
+    // on the table, whatever their order in the pair.
     if (!b.is_static && !b.awake && a.awake) Wake(pair->body_b);
+    if (!a.is_static && !a.awake && b.awake) Wake(pair->body_a);
   }
 }
 

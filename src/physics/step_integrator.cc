@@ -443,6 +443,16 @@ void WorldImpl::UpdateSleep(double dt) {
     Body& body = bodies_[i];
     if (!body.awake) continue;
     const bool speeding_up = UpdateSpeedingUp(dt, &body);
+    if (island_has_link[islands.Find(i)]) {
+      // Held by, resting on or pushed by a link: its quiet time starts
+      // over, so that once the link lets go it must be quiet for
+      // time_to_sleep again; counted on, a box held still for a second fell
+      // asleep in mid-air the step the gripper opened.
+      body.sleep_time = 0.0;
+      RestartSleepWindow(i);
+      island_sleep_time[islands.Find(i)] = 0.0;
+      continue;
+    }
     const bool slow =
         !speeding_up &&
         body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
@@ -454,7 +464,7 @@ void WorldImpl::UpdateSleep(double dt) {
         UpdateSleepWindow(body.WorldFromPrincipal(), limits, dt, &sleep_windows_[i]);
     const double quiet_time = std::max(body.sleep_time, still_time);
     double& island = island_sleep_time[islands.Find(i)];
-    island = std::min(island, island_has_link[islands.Find(i)] ? 0.0 : quiet_time);
+    island = std::min(island, quiet_time);
   }
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];

@@ -147,6 +147,26 @@ TEST(StaticMeshIoTest, TriangleLimitIsMetBeforeTheFileIsRead) {
   std::remove(path.c_str());
 }
 
+// A model spawned static needs no mass: its triangle meshes have no volume
+// to give it one, and no <inertial> is asked for (a bin built of parts).
+TEST(StaticMeshIoTest, SpawnedStaticMeshModelNeedsNoInertial) {
+  for (const bool out_of_process : {false, true}) {
+    UrdfLoadOptions options = out_of_process ? OutOfProcessOptions() : UrdfLoadOptions();
+    options.resolver = ResolvePackage;
+    const Result<LoadedModel> moving = LoadUrdfString(MeshModel(false, ""), options);
+    options.spawn_static = true;
+    const Result<LoadedModel> spawned_static = LoadUrdfString(MeshModel(false, ""), options);
+    ASSERT_TRUE(spawned_static.ok()) << spawned_static.message();
+    EXPECT_EQ(spawned_static->shapes.size(), 2u);
+    for (const LoadedShape& shape : spawned_static->shapes) {
+      EXPECT_TRUE(std::holds_alternative<physics::StaticMesh>(shape.shape.geometry));
+    }
+    // Moving, the same model is its meshes' hulls, with their volume's mass.
+    ASSERT_TRUE(moving.ok()) << moving.message();
+    EXPECT_GT(moving->mass_properties.mass, 0.0);
+  }
+}
+
 TEST(StaticMeshIoTest, TrianglesReplyIsChecked) {
   EXPECT_EQ(ParseTrianglesReply("error boom\n").message(), "boom");
   EXPECT_FALSE(ParseTrianglesReply("triangles 3 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nt 0 1 3\n").ok());

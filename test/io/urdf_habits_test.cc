@@ -262,5 +262,37 @@ TEST(UrdfHabitsTest, GazeboFrictionMayBeAnAttribute) {
   EXPECT_DOUBLE_EQ(model->shapes[0].shape.material.friction, 0.3);
 }
 
+// What a Gazebo description asks for that does not run here (ros_control's
+// transmissions, Gazebo's plugins and sensors) is listed, once each and in
+// document order, for the spawn reply to say; xacro left unexpanded says
+// so instead of "not a number".
+TEST(UrdfHabitsTest, TransmissionsPluginsAndSensorsAreListedAsIgnored) {
+  const std::string xml =
+      "<robot name='r'>" + Link("base", Box("0.1 0.1 0.1")) +
+      "<transmission name='tran1'><type>transmission_interface/SimpleTransmission</type>"
+      "</transmission><gazebo><plugin name='gazebo_ros_control' "
+      "filename='libgazebo_ros_control.so'/></gazebo><gazebo reference='base'><sensor "
+      "type='ray' name='lidar'><plugin name='laser' filename='libgazebo_ros_laser.so'/></sensor>"
+      "</gazebo></robot>";
+  const Result<LoadedModel> model = LoadUrdfString(xml, {});
+  ASSERT_TRUE(model.ok()) << model.message();
+  EXPECT_EQ(model->ignored,
+            (std::vector<std::string>{"<transmission 'tran1'>",
+                                      "<gazebo> plugin 'gazebo_ros_control' "
+                                      "(libgazebo_ros_control.so)",
+                                      "<gazebo reference='base'> sensor 'lidar' (ray)"}));
+  const Result<LoadedModel> unexpanded =
+      LoadUrdfString("<robot name='r'>" + Link("base", Box("${s} 1 1")) + "</robot>", {});
+  ASSERT_FALSE(unexpanded.ok());
+  EXPECT_NE(unexpanded.message().find("unexpanded xacro"), std::string::npos)
+      << unexpanded.message();
+  const Result<LoadedModel> xacro =
+      LoadUrdfString("<robot name='r' xmlns:xacro='http://www.ros.org/wiki/xacro'>" +
+                         Link("base", Box("1 1 1")) + "</robot>",
+                     {});
+  ASSERT_FALSE(xacro.ok());
+  EXPECT_NE(xacro.message().find("the description is xacro"), std::string::npos) << xacro.message();
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::io

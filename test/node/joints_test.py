@@ -255,6 +255,75 @@ class JointsTest(unittest.TestCase):
         self.assertAlmostEqual(0.6, states.position[0], delta=2e-4)
         self.assertAlmostEqual(-0.4, states.position[1], delta=2e-4)
 
+    def test_command_takes_only_its_joints_from_a_trajectory(self):
+        # ros_control's habit: an arm's trajectory and a gripper's command
+        # are two controllers on disjoint joints. The elbow's command takes
+        # the elbow alone; the shoulder follows its trajectory to the end.
+        self.spawn_urdf('arm5', 'two_link_arm.urdf', 1.5)
+        publisher = rospy.Publisher(SIM + 'arm5/joint_trajectory', JointTrajectory, queue_size=1,
+                                    latch=True)
+        trajectory = JointTrajectory()
+        trajectory.joint_names = ['shoulder', 'elbow']
+        point = JointTrajectoryPoint()
+        point.positions = [0.6, -0.4]
+        point.time_from_start = rospy.Duration(1.0)
+        trajectory.points.append(point)
+        publisher.publish(trajectory)
+        rospy.sleep(0.5)
+        self.step(60)  # 0.25 s into the trajectory
+        self.command('arm5', name=['elbow'], position=[0.3])
+        self.step(300)  # 1.5 s in all: the trajectory's end, held for 0.5 s
+        states = self.joint_states('arm5')
+        self.assertAlmostEqual(0.6, states.position[0], delta=2e-4)
+        self.assertAlmostEqual(0.3, states.position[1], delta=2e-4)
+        # A trajectory for the shoulder alone leaves the elbow's command.
+        trajectory.joint_names = ['shoulder']
+        point.positions = [-0.2]
+        publisher.publish(trajectory)
+        rospy.sleep(0.5)
+        self.step(360)
+        states = self.joint_states('arm5')
+        self.assertAlmostEqual(-0.2, states.position[0], delta=2e-4)
+        self.assertAlmostEqual(0.3, states.position[1], delta=2e-4)
+
+    def test_world_joint_origin_places_the_model(self):
+        # Gazebo and robot_state_publisher: the spawn pose is the URDF's
+        # 'world' frame, and the root sits at the fixed joint's <origin>
+        # from it. Spawn pose (1, 2, 0.3) turned 0.2 rad about z, origin
+        # (0.5, 0, 1.2) turned 0.5 rad: the root at (1, 2, 0.3) + Rz(0.2)
+        # (0.5, 0, 1.2), turned 0.7 rad; for a rigid model and an arm alike.
+        link = ("<link name='base'><inertial><mass value='1'/><inertia ixx='0.01' iyy='0.01' "
+                "izz='0.01' ixy='0' ixz='0' iyz='0'/></inertial><collision><geometry>"
+                "<box size='0.1 0.1 0.1'/></geometry></collision></link>")
+        arm = ("<joint name='hinge' type='revolute'><parent link='base'/><child link='rod'/>"
+               "<axis xyz='0 1 0'/><limit lower='-1' upper='1' effort='10' velocity='1'/>"
+               "</joint><link name='rod'><inertial><origin xyz='0 0 -0.2'/><mass value='1'/>"
+               "<inertia ixx='0.01' iyy='0.01' izz='0.01' ixy='0' ixz='0' iyz='0'/>"
+               "</inertial></link>")
+        yaw = 0.2
+        for name, extra in (('mounted', ''), ('mounted_arm', arm)):
+            request = SpawnRequest()
+            request.name = name
+            request.urdf = ("<robot name='r'><link name='world'/><joint name='fix' type='fixed'>"
+                            "<parent link='world'/><child link='base'/>"
+                            "<origin xyz='0.5 0 1.2' rpy='0 0 0.5'/></joint>" + link + extra +
+                            "</robot>")
+            request.pose.position.x, request.pose.position.y = 1.0, 2.0
+            request.pose.position.z = 0.3
+            request.pose.orientation.z, request.pose.orientation.w = (math.sin(yaw / 2),
+                                                                      math.cos(yaw / 2))
+            request.friction = -1.0
+            request.restitution = -1.0
+            response = self.spawn(request)
+            self.assertTrue(response.success, response.message)
+            self.addCleanup(self.delete, name)
+            pose = self.get_state(name + '/base').pose
+            self.assertAlmostEqual(1.0 + 0.5 * math.cos(yaw), pose.position.x, delta=1e-9)
+            self.assertAlmostEqual(2.0 + 0.5 * math.sin(yaw), pose.position.y, delta=1e-9)
+            self.assertAlmostEqual(0.3 + 1.2, pose.position.z, delta=1e-9)
+            self.assertAlmostEqual(math.sin(0.35), pose.orientation.z, delta=1e-9)
+            self.assertAlmostEqual(math.cos(0.35), pose.orientation.w, delta=1e-9)
+
     def test_tf_holds_the_link_frames(self):
         self.spawn_urdf('arm4', 'two_link_arm.urdf', 1.5, {'shoulder': math.pi / 2})
         self.step(1)

@@ -41,7 +41,11 @@ class NodeServicesTest : public ::testing::Test {
   }
 
   ros::NodeHandle node_{"/rigid_body_sim"};
-  SimClient client_;
+  // One connection per service for the whole test: a call on a connection
+  // of its own now and then fails in roscpp under load ("service call
+  // failed" with the node healthy; ros/ros_comm#1976, a race in the
+  // per-call connection's teardown), which made this test flaky.
+  SimClient client_{/*persistent=*/true};
   Latest<rigid_body_sim::ModelStates> states_{node_, "states"};
   std::vector<std::string> spawned_;
 };

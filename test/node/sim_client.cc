@@ -77,6 +77,9 @@ typename Service::Response SimClient::Call(const std::string& name,
   Service service;
   service.request = std::move(request);
   if (!it->second.call(service)) {
+    // A persistent connection that failed is dropped, so the next call
+    // connects afresh instead of failing on the dead one.
+    if (persistent_) clients_.erase(it);
     service.response = typename Service::Response();
     service.response.success = false;
     service.response.message = "service call failed";

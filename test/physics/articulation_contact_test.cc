@@ -294,5 +294,72 @@ TEST(ArticulationContactTest, GripperLiftsABoxWithoutLettingItSlip) {
   EXPECT_LT(std::abs(end_offset - start_offset), 5e-3);
 }
 
+// A gripper of two fingers on prismatic joints holds a 5 cm, 0.1 kg box
+// still for 3 s (six times time_to_sleep), then opens. Sleep follows the
+// link: while held the box stays awake, and let go it falls freely,
+// ~g t^2 / 2, to the ground and rests there, instead of sleeping where it
+// was held (its quiet time had counted on through the hold, and it fell
+// asleep in mid-air the step the fingers opened).
+TEST(ArticulationContactTest, BoxLetGoByAGripperFallsInsteadOfSleepingInTheAir) {
+  World world = MakeWorld();
+  AddGround(&world, MakeMaterial(0.8, 0.0));
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.world_from_base = Translation(0, 0, 0.5);
+  def.links.push_back(Anchor());
+  const Vec3 pad_size(0.01, 0.04, 0.06);
+  for (const int side : {-1, 1}) {
+    LinkDef finger;
+    finger.mass_properties = BoxMassProperties(1000.0, pad_size);
+    ShapeDef pad;
+    pad.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(pad_size));
+    pad.material = MakeMaterial(1.0, 0.0);
+    finger.shapes.push_back(pad);
+    def.links.push_back(finger);
+    JointDef slider = Slider(side < 0 ? "left" : "right", 0, static_cast<int>(def.links.size()) - 1,
+                             Vec3(side * 0.03, 0, 0), Vec3(side, 0, 0));
+    slider.lower = -0.1;
+    slider.upper = 0.1;
+    slider.effort_limit = 100.0;
+    def.joints.push_back(slider);
+  }
+  const Result<ArticulationId> gripper = world.CreateArticulation(def);
+  ASSERT_TRUE(gripper.ok()) << gripper.message();
+  BoxSpec spec;
+  spec.size = Vec3(0.05, 0.05, 0.05);
+  spec.mass = 0.1;
+  spec.world_from_body = Translation(0, 0, 0.5);
+  spec.material = MakeMaterial(1.0, 0.0);
+  const BodyId box = AddBox(&world, spec);
+  const auto command_both = [&](double position) {
+    JointCommand command;
+    command.mode = JointCommandMode::kPosition;
+    command.position = position;
+    for (const int joint : {0, 1})
+      ASSERT_TRUE(world.SetJointCommand(*gripper, joint, command).ok());
+  };
+  command_both(-0.01);  // 1 cm into the box: a firm squeeze
+  for (int step = 0; step < 3 * 240; ++step) world.Step();
+  const double held_z = world.GetPose(box).translation.z();
+  EXPECT_NEAR(held_z, 0.5, 1e-3);
+  EXPECT_TRUE(world.GetBody(box).awake);
+  command_both(0.05);
+  double released_at = -1.0;
+  for (int step = 0; step < 240; ++step) {
+    world.Step();
+    const Body& body = world.GetBody(box);
+    if (released_at < 0.0 && body.linear_velocity.z() < -0.01) released_at = world.time();
+    // Never asleep above the ground while it falls.
+    if (world.GetPose(box).translation.z() > 0.03) {
+      EXPECT_TRUE(body.awake) << world.time();
+    }
+  }
+  ASSERT_GT(released_at, 0.0);
+  // 0.475 m of free fall takes sqrt(2 h / g) = 0.311 s: within the second
+  // after release it is on the ground, at half its size, at rest.
+  EXPECT_NEAR(world.GetPose(box).translation.z(), 0.025, 1e-3);
+  EXPECT_LT(world.GetBody(box).linear_velocity.norm(), 0.05);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::physics::testing

@@ -75,6 +75,10 @@ using MeshPiecesLoader =
     std::function<physics::Result<std::shared_ptr<const std::vector<physics::ConvexPolyhedron>>>(
         const std::string& path, const physics::Vec3& scale, const DecompositionOptions& options,
         PiecesRule rule)>;
+// Expands a xacro description: the file at `path`, or `text` when `path` is
+// empty (xacro_process.h runs the package's expander out of process).
+using XacroExpander =
+    std::function<physics::Result<std::string>(const std::string& path, const std::string& text)>;
 
 struct UrdfLoadOptions {
   // kg/m^3: density of links without <inertial>, whose mass properties are
@@ -107,6 +111,9 @@ struct UrdfLoadOptions {
   // else are built in this process.
   DecompositionOptions decomposition;
   MeshPiecesLoader mesh_pieces_loader;
+  // A description that is xacro (LooksLikeXacro) is expanded by it first;
+  // without one it is refused, saying so.
+  XacroExpander xacro_expander;
   // The caller spawns the model static whatever its URDF says (a spawn
   // request's is_static): its meshes then keep their triangles by default,
   // as those of a model fixed to `world` do. A <gazebo reference="LINK">
@@ -177,6 +184,7 @@ struct LoadedModel {
   std::string root_link;                    // body frame
   bool is_static = false;                   // fixed to a link named `world`
   physics::Pose world_from_root;            // origin of the joint to `world`; identity if none
+  bool world_link = false;                  // the URDF's root is a link named `world`
   physics::MassProperties mass_properties;  // root-link frame; validated unless static
   std::vector<LoadedShape> shapes;          // root-link frame
   std::vector<LinkFrame> links;             // every link of the body, root first
@@ -185,6 +193,9 @@ struct LoadedModel {
   // one movable joint): the model becomes an articulation.
   bool articulated = false;
   std::vector<std::string> warnings;  // e.g. inertia computed from geometry
+  // What the description asks for that is not simulated, one entry each:
+  // <transmission> and <gazebo><plugin> elements (IgnoredElements).
+  std::vector<std::string> ignored;
 };
 
 // Parses a URDF document. Fails, naming the element, on malformed XML,

@@ -24,6 +24,13 @@ struct FrameState {
   physics::Vec3 angular_velocity = physics::Vec3::Zero();  // rad/s, world
 };
 
+// Which of a model's frames the node publishes on tf.
+enum class TfMode {
+  kLinks,  // every link: the world to the root, then the URDF tree
+  kRoot,   // the world to the root link only; robot_state_publisher does the rest
+  kNone,   // none
+};
+
 // What a caller asks to spawn, from the Spawn service or the ~models parameter.
 struct ModelSpec {
   std::string name;       // [A-Za-z_][A-Za-z0-9_]*
@@ -39,7 +46,24 @@ struct ModelSpec {
   // Links of an articulated model collide with each other (never two
   // joined by one joint), like Gazebo's <self_collide>.
   bool self_collide = false;
+  // Where its joint topics live: "" under ~<name>/, "/" global, else that
+  // namespace (ValidateRobotNamespace).
+  std::string robot_namespace;
+  std::string tf_prefix;  // "": "<name>/"; "/": none; else as given
+  TfMode tf_mode = TfMode::kLinks;
+  bool hold = false;                    // servos hold the spawn positions until commanded
+  std::vector<std::string> xacro_args;  // name:=value
 };
+
+// "" stays "" (the node's private namespace); any other is made absolute
+// without a trailing '/': "arm" -> "/arm", "/" -> "/". Fails naming the
+// field on a name ROS does not allow ([A-Za-z][A-Za-z0-9_]* segments).
+physics::Result<std::string> ResolveRobotNamespace(const std::string& robot_namespace);
+// The prefix of the model's tf frames: "<name>/" for "", "" for "/", else
+// `tf_prefix`, which may hold only [A-Za-z0-9_./-] and not start with '/'.
+physics::Result<std::string> ResolveTfPrefix(const std::string& name, const std::string& tf_prefix);
+// "" and "links", "root", "none".
+physics::Result<TfMode> TfModeFromName(const std::string& mode);
 
 // Materials of shapes the spec and the URDF leave open.
 struct MaterialDefaults {
@@ -94,7 +118,17 @@ struct Model {
   std::vector<io::JointInfo> joints;  // every joint but one to 'world'
   double mass = 0.0;                  // kg, of the body; 0 when static
   FrameState spawn_state;             // of the root link, restored by a reset
+  std::string robot_namespace;        // resolved: "" for ~<name>/
+  std::string tf_prefix;              // resolved
+  TfMode tf_mode = TfMode::kLinks;
+  bool hold = false;  // servos hold the spawn positions, at spawn and reset
+  // The URDF's root is a `world` link: robot_state_publisher publishes its
+  // world -> root itself, so TfMode::kRoot adds nothing.
+  bool world_link = false;
 };
+
+// The tf frame of a link of `model`: its tf prefix and the link's name.
+std::string TfFrame(const Model& model, const std::string& link);
 
 // A frame of a model: the model and one of its links.
 struct FrameRef {

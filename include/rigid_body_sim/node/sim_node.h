@@ -100,7 +100,28 @@ class SimNode {
   // Locks the world mutex, telling the step loop to let the caller in first.
   std::unique_lock<std::mutex> LockWorld();
 
-  physics::Result<std::vector<std::string>> SpawnModel(const ModelSpec& spec);
+  struct SpawnedModel {
+    std::vector<std::string> frames;   // tf frames of its links
+    std::vector<std::string> ignored;  // elements of the description not simulated
+  };
+  physics::Result<SpawnedModel> SpawnModel(const ModelSpec& spec);
+  // What SpawnModel makes of a spec before it locks the world.
+  struct PreparedModel {
+    io::LoadedModel loaded;
+    physics::BodyDef def;
+    std::optional<physics::ArticulationDef> articulation;
+    Model model;  // its fields from the spec and the URDF; bodies not yet made
+    std::vector<visualization_msgs::Marker> markers;
+    std::vector<std::string> warnings;
+  };
+  physics::Result<PreparedModel> PrepareModel(const ModelSpec& spec,
+                                              const MaterialDefaults& defaults) const;
+  // Adds the prepared model to the world and the registry; its tf frames.
+  physics::Result<std::vector<std::string>> CommitModelLocked(const ModelSpec& spec,
+                                                              PreparedModel* prepared,
+                                                              Outbox* outbox);
+  // The name and the robot namespace are free.
+  physics::Status CheckNamesFreeLocked(const ModelSpec& spec) const;
   std::string DescribeOverlaps(const std::string& model_name);
   physics::Result<io::LoadedModel> LoadModel(const ModelSpec& spec) const;
   physics::Status CreateBodyLocked(const physics::BodyDef& def, const io::LoadedModel& loaded,
@@ -140,6 +161,8 @@ class SimNode {
   // Puts an articulated model's joints back where it spawned, at rest,
   // with no command.
   physics::Status ResetJointsLocked(const Model& model);
+  // The servos of every joint that mimics none hold its spawn position.
+  void HoldJointsLocked(const Model& model);
 
   bool OnSpawn(rigid_body_sim::Spawn::Request& request, rigid_body_sim::Spawn::Response& response);
   bool OnDelete(rigid_body_sim::Delete::Request& request,
@@ -243,10 +266,20 @@ class SimNode {
   };
   struct ActiveTrajectory {
     std::vector<int> joints;  // indices into the model's joint_names
+    // Per entry of `joints`: still driven by this trajectory. A later
+    // command or trajectory naming the joint takes it over.
+    std::vector<bool> owned;
     JointTrajectory plan;
     double start_time = 0.0;  // s of sim time
   };
-  std::map<std::string, ActiveTrajectory> trajectories_;  // by model, under mutex_
+  // By model, under mutex_: the trajectories in progress, on disjoint
+  // joints, oldest first.
+  std::map<std::string, std::vector<ActiveTrajectory>> trajectories_;
+  // Takes `joints` of the model from the trajectories in progress; those
+  // left with no joint go to `released`, to be freed without the lock.
+  void ReleaseJointsLocked(const std::string& model_name, const std::vector<int>& joints,
+                           std::vector<ActiveTrajectory>* released);
+
   std::mutex joint_topics_mutex_;
   std::map<std::string, JointTopics> joint_topics_;  // by model
   std::vector<JointTopics> retired_joint_topics_;    // of deleted models, to destroy
