@@ -35,10 +35,15 @@ Result<JointTrajectory> JointTrajectory::Plan(std::size_t joints,
   for (std::size_t k = 0; k < points.size(); ++k) {
     const TrajectoryPoint& point = points[k];
     const std::string where = "point " + std::to_string(k);
-    if (!std::isfinite(point.time) || point.time < 0.0 || point.time <= previous) {
-      return Result<JointTrajectory>::Error(
-          where + " time_from_start " + FormatNumber(point.time) +
-          " s must be finite, >= 0 and later than the point before");
+    // Points closer than kMinPointGap would make the slopes between them,
+    // and so the commanded velocities, overflow (2e4 rad over 1e-300 s).
+    const bool too_close = k == 0 ? point.time > 0.0 && point.time < kMinPointGap
+                                  : point.time < previous + kMinPointGap;
+    if (!std::isfinite(point.time) || point.time < 0.0 || too_close) {
+      return Result<JointTrajectory>::Error(where + " time_from_start " + FormatNumber(point.time) +
+                                            " s must be finite, >= 0 and at least " +
+                                            FormatNumber(kMinPointGap) +
+                                            " s later than the point before (or the start)");
     }
     previous = point.time;
     if (point.positions.size() != joints ||

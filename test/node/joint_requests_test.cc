@@ -116,5 +116,30 @@ TEST(JointRequestsTest, FirstPointsEstimateUsesTheStart) {
   EXPECT_EQ(parsed->plan.Sample(5.0).positions[0], 3.0);
 }
 
+// Points 1e-300 s apart would give slopes of 1e304 rad/s and samples that
+// overflow (found by joint_requests_fuzzer): points must be at least
+// kMinPointGap apart, and so every sample is finite.
+TEST(JointRequestsTest, PointsCloserThanTheLeastGapAreRefused) {
+  JointTrajectoryRequest request;
+  request.joint_names = {"shoulder"};
+  request.points = {{{1.0}, {}, 0.5}, {{-1.0}, {}, 0.5 + 1e-300}, {{1.0}, {}, 1.0}};
+  ExpectRefused(ParseJointTrajectory(Joints(), request, RequestLimits()).status(),
+                "point 1 time_from_start");
+  request.points = {{{1.0}, {}, 1e-9}};
+  ExpectRefused(ParseJointTrajectory(Joints(), request, RequestLimits()).status(),
+                "point 0 time_from_start");
+  // 1.5 gaps apart: the closest points the rule lets through, up to
+  // rounding, swinging across the whole position range.
+  const double gap = 1.5 * JointTrajectory::kMinPointGap;
+  request.points = {{{1e4}, {}, 0.5}, {{-1e4}, {}, 0.5 + gap}, {{1e4}, {}, 0.5 + 2 * gap}};
+  auto parsed = ParseJointTrajectory(Joints(), request, RequestLimits());
+  ASSERT_TRUE(parsed.ok()) << parsed.message();
+  ASSERT_TRUE(parsed.value().plan.Begin({0.0, {0.0}, {0.0}}).ok());
+  for (double t = 0.5; t < 0.5 + 2.5 * gap; t += 1e-7) {
+    const TrajectorySample sample = parsed->plan.Sample(t);
+    EXPECT_TRUE(std::isfinite(sample.positions[0]) && std::isfinite(sample.velocities[0])) << t;
+  }
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::node

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <thread>
@@ -138,6 +139,8 @@ TEST_F(NodeHostileJointsTest, LongTrajectoryWithinLimitsStallsNoCall) {
   prober.join();
   EXPECT_TRUE(reached) << "shoulder at " << ShoulderAngle(client_) << " rad";
   EXPECT_LT(slowest.load(), 0.5) << "a ~get_physics call waited " << slowest.load() << " s";
+  std::printf("slowest ~get_physics while a 100,000-point trajectory was taken in: %.3f s\n",
+              slowest.load());
 }
 
 TEST_F(NodeHostileJointsTest, PackageUriCannotLeaveItsPackage) {

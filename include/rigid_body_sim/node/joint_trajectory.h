@@ -23,10 +23,14 @@ struct TrajectorySample {
 
 class JointTrajectory {
  public:
+  // s: the least time between two points, and from the start to the first
+  // point unless it is at 0. ROS trajectories come at most at some kHz.
+  static constexpr double kMinPointGap = 1e-6;
+
   // `start` holds the joints' positions and velocities when the trajectory
-  // begins (time 0); `points` must have strictly increasing times > 0 (a
-  // first point at time 0 replaces the start) and one finite value per
-  // joint. Velocities left out are estimated: the mean of the slopes to
+  // begins (time 0); `points` must have times increasing by at least
+  // kMinPointGap (a first point at time 0 replaces the start) and one
+  // finite value per joint. Velocities left out are estimated: the mean of the slopes to
   // the neighbouring points, 0 at the last point.
   static physics::Result<JointTrajectory> Make(const TrajectoryPoint& start,
                                                std::vector<TrajectoryPoint> points);
