@@ -564,7 +564,15 @@ std::vector<std::string> IgnoredElements(const TiXmlElement& robot) {
                         attribute(*sensor, "type") + ")");
     }
   }
-  return ignored;
+  // Once each: descriptions repeat a transmission per hardware interface
+  // (Franka's gives every joint three of the same name).
+  std::vector<std::string> unique;
+  for (std::string& element : ignored) {
+    if (std::find(unique.begin(), unique.end(), element) == unique.end()) {
+      unique.push_back(std::move(element));
+    }
+  }
+  return unique;
 }
 
 }  // namespace rigid_body_sim::io

@@ -50,7 +50,7 @@ bool EveryLinkIsMassless(const TiXmlElement& robot);
 // The model will be static: spawned so, fixed to 'world', or massless.
 bool IsStaticDocument(const TiXmlElement& robot, const UrdfLoadOptions& options);
 
-// One entry per <transmission> (ros_control's; joint commands drive the
+// One entry per distinct <transmission> (ros_control's; joint commands drive the
 // joints directly) and per <gazebo><plugin> (Gazebo's plugins do not run
 // here) and <gazebo><sensor>; transmissions first, then Gazebo's, each in
 // document order: "<transmission 'NAME'>",

@@ -270,7 +270,7 @@ TEST(UrdfHabitsTest, TransmissionsPluginsAndSensorsAreListedAsIgnored) {
   const std::string xml =
       "<robot name='r'>" + Link("base", Box("0.1 0.1 0.1")) +
       "<transmission name='tran1'><type>transmission_interface/SimpleTransmission</type>"
-      "</transmission><gazebo><plugin name='gazebo_ros_control' "
+      "</transmission><transmission name='tran1'/><gazebo><plugin name='gazebo_ros_control' "
       "filename='libgazebo_ros_control.so'/></gazebo><gazebo reference='base'><sensor "
       "type='ray' name='lidar'><plugin name='laser' filename='libgazebo_ros_laser.so'/></sensor>"
       "</gazebo></robot>";
