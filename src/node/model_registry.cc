@@ -150,8 +150,11 @@ Result<std::string> ResolveRobotNamespace(const std::string& robot_namespace) {
   return resolved;
 }
 
-Result<std::string> ResolveTfPrefix(const std::string& name, const std::string& tf_prefix) {
-  if (tf_prefix.empty()) return name + names::kFrameSeparator;
+Result<std::string> ResolveTfPrefix(const std::string& name, const std::string& tf_prefix,
+                                    TfMode mode) {
+  // robot_state_publisher names the other links as the URDF does, so the
+  // root it hangs them from is unprefixed too.
+  if (tf_prefix.empty()) return mode == TfMode::kRoot ? "" : name + names::kFrameSeparator;
   if (tf_prefix == "/") return std::string();
   const bool allowed =
       tf_prefix.front() != '/' && std::all_of(tf_prefix.begin(), tf_prefix.end(), [](char c) {

@@ -83,7 +83,8 @@ Status ValidateModelSpec(const ModelSpec& spec, const RequestLimits& limits) {
   if (Status status = ResolveRobotNamespace(spec.robot_namespace).status(); !status.ok()) {
     return status;
   }
-  if (Status status = ResolveTfPrefix(spec.name, spec.tf_prefix).status(); !status.ok()) {
+  if (Status status = ResolveTfPrefix(spec.name, spec.tf_prefix, spec.tf_mode).status();
+      !status.ok()) {
     return status;
   }
   // Negative means "not set"; NaN is neither.

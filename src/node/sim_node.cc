@@ -346,7 +346,7 @@ Result<SimNode::PreparedModel> SimNode::PrepareModel(const ModelSpec& spec,
   }
   prepared.model.name = spec.name;
   prepared.model.robot_namespace = ResolveRobotNamespace(spec.robot_namespace).value();
-  prepared.model.tf_prefix = ResolveTfPrefix(spec.name, spec.tf_prefix).value();
+  prepared.model.tf_prefix = ResolveTfPrefix(spec.name, spec.tf_prefix, spec.tf_mode).value();
   prepared.model.tf_mode = spec.tf_mode;
   prepared.model.hold = spec.hold;
   prepared.model.world_link = loaded->world_link;

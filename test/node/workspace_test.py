@@ -42,9 +42,9 @@ class WorkspaceTest(unittest.TestCase):
         joints = ['joint%d' % (i + 1) for i in range(7)]
         pose = [0.3, -0.5, 0.2, -1.8, 0.1, 1.4, 0.5]
         # Its base fixed where it is spawned (is_static keeps the joints).
-        request = SpawnRequest(name='panda_like', robot_namespace='/', tf_prefix='/',
-                               tf_mode='root', hold=True, is_static=True, friction=-1.0,
-                               restitution=-1.0)
+        # No tf_prefix: in root mode the frames are the URDF's own names.
+        request = SpawnRequest(name='panda_like', robot_namespace='/', tf_mode='root',
+                               hold=True, is_static=True, friction=-1.0, restitution=-1.0)
         request.urdf_path = self.package + '/test/data/seven_dof_arm_free.urdf'
         request.pose = Pose()
         request.pose.position.x, request.pose.position.y = 0.4, 1.2

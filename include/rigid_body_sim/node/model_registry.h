@@ -59,9 +59,12 @@ struct ModelSpec {
 // without a trailing '/': "arm" -> "/arm", "/" -> "/". Fails naming the
 // field on a name ROS does not allow ([A-Za-z][A-Za-z0-9_]* segments).
 physics::Result<std::string> ResolveRobotNamespace(const std::string& robot_namespace);
-// The prefix of the model's tf frames: "<name>/" for "", "" for "/", else
-// `tf_prefix`, which may hold only [A-Za-z0-9_./-] and not start with '/'.
-physics::Result<std::string> ResolveTfPrefix(const std::string& name, const std::string& tf_prefix);
+// The prefix of the model's tf frames: for "", "<name>/" (none in
+// TfMode::kRoot, where robot_state_publisher names the links as the URDF
+// does); "" for "/"; else `tf_prefix`, which may hold only [A-Za-z0-9_./-]
+// and not start with '/'.
+physics::Result<std::string> ResolveTfPrefix(const std::string& name, const std::string& tf_prefix,
+                                             TfMode mode);
 // "" and "links", "root", "none".
 physics::Result<TfMode> TfModeFromName(const std::string& mode);
 
