@@ -1,6 +1,5 @@
 #include "rigid_body_sim/io/urdf_loader.h"
 
-#include "rigid_body_sim/io/xacro_process.h"
 
 #include <algorithm>
 #include <cctype>
@@ -24,6 +23,7 @@
 #include "io/mesh_collision_modes.h"
 #include "io/urdf_checks.h"
 #include "io/urdf_elements.h"
+#include "io/urdf_load_options.h"
 #include "io/urdf_meshes.h"
 
 namespace rigid_body_sim::io {
@@ -536,54 +536,18 @@ class ModelBuilder {
   UrdfMeshes meshes_;
 };
 
-Status ValidateOptions(const UrdfLoadOptions& options) {
-  if (!PositiveFinite(options.default_density)) {
-    return Status::Error("URDF load option default_density must be positive and finite, got " +
-                         FormatNumber(options.default_density));
-  }
-  if (options.max_joints < 1) {
-    return Status::Error("URDF load option max_joints must be at least 1, got " +
-                         std::to_string(options.max_joints));
-  }
-  if (options.max_links < 1) {
-    return Status::Error("URDF load option max_links must be at least 1, got " +
-                         std::to_string(options.max_links));
-  }
-  if (options.hull.max_vertices < 4) {
-    return Status::Error("URDF load option hull.max_vertices must be at least 4, got " +
-                         std::to_string(options.hull.max_vertices));
-  }
-  return Status::Ok();
-}
-
-UriResolver ResolverOrDefault(const UrdfLoadOptions& options) {
-  return options.resolver ? options.resolver : UriResolver(ResolveFileUri);
-}
-
-// The URDF of a description: itself, or what the xacro expander makes of it.
-Result<std::string> Expanded(const std::string& path, const std::string& text,
-                             const UrdfLoadOptions& options) {
-  if (!LooksLikeXacro(path, text)) return text;
-  if (!options.xacro_expander) {
-    return Result<std::string>::Error(
-        "the description is xacro (a .xacro file or the xacro namespace); this load takes URDF "
-        "only");
-  }
-  return options.xacro_expander(path, path.empty() ? text : std::string());
-}
-
 }  // namespace
 
 Result<LoadedModel> LoadUrdfString(const std::string& xml, const UrdfLoadOptions& options) {
-  const Status status = ValidateOptions(options);
+  const Status status = ValidateLoadOptions(options);
   if (!status.ok()) return status;
-  const Result<std::string> urdf = Expanded("", xml, options);
+  const Result<std::string> urdf = ExpandedDescription("", xml, options);
   if (!urdf.ok()) return urdf.status();
   return ModelBuilder(options, ResolverOrDefault(options)).Build(*urdf);
 }
 
 Result<LoadedModel> LoadUrdfFile(const std::string& path, const UrdfLoadOptions& options) {
-  const Status status = ValidateOptions(options);
+  const Status status = ValidateLoadOptions(options);
   if (!status.ok()) return status;
   // Checked before reading: /dev/zero would fill the memory, a FIFO would
   // block the caller.
@@ -612,7 +576,7 @@ Result<LoadedModel> LoadUrdfFile(const std::string& path, const UrdfLoadOptions&
     if (!resolved.ok() || std::filesystem::path(*resolved).is_absolute()) return resolved;
     return (directory / *resolved).string();
   };
-  const Result<std::string> urdf = Expanded(path, contents.str(), options);
+  const Result<std::string> urdf = ExpandedDescription(path, contents.str(), options);
   if (!urdf.ok())
     return Result<LoadedModel>::Error("URDF file " + Quoted(path) + ": " + urdf.message());
   Result<LoadedModel> model = ModelBuilder(options, relative_to_file).Build(*urdf);
