@@ -259,16 +259,16 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
     positions.push_back(state.position);
     velocities.push_back(state.velocity);
   }
+  const std::shared_ptr<const ModelJoints> joints = ModelJointsOf(*model);
   for (std::size_t i = 0; i < count; ++i) {
     const std::string& name = request.joint_names[i];
-    const auto found = std::find(model->joint_names.begin(), model->joint_names.end(), name);
-    if (found == model->joint_names.end()) {
+    const auto found = joints->index.find(name);
+    if (found == joints->index.end()) {
       return fail("model '" + model_name + "' has no movable joint '" + name + "'");
     }
-    for (const io::JointInfo& info : model->joints) {
-      if (info.name == name && !info.mimic_joint.empty()) {
-        return fail("joint '" + name + "' mimics '" + info.mimic_joint + "'; set that joint");
-      }
+    const std::size_t joint = static_cast<std::size_t>(found->second);
+    if (!joints->leaders[joint].empty()) {
+      return fail("joint '" + name + "' mimics '" + joints->leaders[joint] + "'; set that joint");
     }
     if (std::find(request.joint_names.begin(), request.joint_names.begin() + i, name) !=
         request.joint_names.begin() + i) {
@@ -276,15 +276,12 @@ bool SimNode::OnSetJointState(rigid_body_sim::SetJointState::Request& request,
     }
     JointValues values;
     values.field = "joint '" + name + "'";
-    for (const io::JointInfo& info : model->joints) {
-      if (info.name == name) values.prismatic = info.type == "prismatic";
-    }
+    values.prismatic = joints->prismatic[joint];
     values.position = request.positions[i];
     values.velocity = request.velocities.empty() ? 0.0 : request.velocities[i];
     if (Status status = ValidateJointValues(values, options_.limits); !status.ok()) {
       return fail(status.message());
     }
-    const std::size_t joint = static_cast<std::size_t>(found - model->joint_names.begin());
     positions[joint] = values.position;
     velocities[joint] = values.velocity;
   }
@@ -308,11 +305,9 @@ Status SimNode::ResetJointsLocked(const Model& model) {
 }
 
 void SimNode::HoldJointsLocked(const Model& model) {
+  const std::shared_ptr<const ModelJoints> joints = ModelJointsOf(model);
   for (std::size_t j = 0; j < model.joint_names.size(); ++j) {
-    const bool mimic = std::any_of(model.joints.begin(), model.joints.end(), [&](const auto& info) {
-      return info.name == model.joint_names[j] && !info.mimic_joint.empty();
-    });
-    if (mimic) continue;
+    if (!joints->leaders[j].empty()) continue;  // a mimic follows its leader
     JointCommand hold;
     hold.mode = physics::JointCommandMode::kPosition;
     hold.position = model.spawn_joint_positions[j];
