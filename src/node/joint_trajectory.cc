@@ -37,12 +37,14 @@ Result<JointTrajectory> JointTrajectory::Plan(std::size_t joints,
     const std::string where = "point " + std::to_string(k);
     // Points closer than kMinPointGap would make the slopes between them,
     // and so the commanded velocities, overflow (2e4 rad over 1e-300 s).
+    // The gap is a difference, not previous + gap: far from 0 the sum
+    // rounds back to previous and two points could share one time.
     const bool too_close = k == 0 ? point.time > 0.0 && point.time < kMinPointGap
-                                  : point.time < previous + kMinPointGap;
-    if (!std::isfinite(point.time) || point.time < 0.0 || too_close) {
+                                  : !(point.time - previous >= kMinPointGap);
+    if (!(point.time >= 0.0 && point.time <= kMaxPointTime) || too_close) {
       return Result<JointTrajectory>::Error(where + " time_from_start " + FormatNumber(point.time) +
-                                            " s must be finite, >= 0 and at least " +
-                                            FormatNumber(kMinPointGap) +
+                                            " s must be in [0, " + FormatNumber(kMaxPointTime) +
+                                            "] and at least " + FormatNumber(kMinPointGap) +
                                             " s later than the point before (or the start)");
     }
     previous = point.time;

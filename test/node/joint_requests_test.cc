@@ -141,5 +141,34 @@ TEST(JointRequestsTest, PointsCloserThanTheLeastGapAreRefused) {
   }
 }
 
+// Far from 0, t + kMinPointGap rounds back to t: two points at 8.9e194 s
+// passed the gap rule and Sample divided 0 by 0 (joint_requests_fuzzer).
+// A point later than a ROS duration's span (2^31 s) is refused, and at that
+// span points kMinPointGap apart still sample finite and in order.
+TEST(JointRequestsTest, PointsBeyondTheLatestTimeAreRefused) {
+  JointTrajectoryRequest request;
+  request.joint_names = {"shoulder"};
+  request.points = {{{1.0}, {}, 8.9e194}, {{-1.0}, {}, 8.9e194}};
+  ExpectRefused(ParseJointTrajectory(Joints(), request, RequestLimits()).status(),
+                "point 0 time_from_start");
+  request.points = {{{1.0}, {}, 1.0},
+                    {{-1.0}, {}, std::nextafter(JointTrajectory::kMaxPointTime, 1e300)}};
+  ExpectRefused(ParseJointTrajectory(Joints(), request, RequestLimits()).status(),
+                "point 1 time_from_start");
+  // 1.5 gaps: the doubles near 2^31 are 4.8e-7 s apart, so last - gap
+  // itself rounds to less than a gap before last.
+  const double last = JointTrajectory::kMaxPointTime;
+  const double gap = 1.5 * JointTrajectory::kMinPointGap;
+  request.points = {{{1e4}, {}, last - gap}, {{-1e4}, {}, last}};
+  auto parsed = ParseJointTrajectory(Joints(), request, RequestLimits());
+  ASSERT_TRUE(parsed.ok()) << parsed.message();
+  ASSERT_TRUE(parsed.value().plan.Begin({0.0, {0.0}, {0.0}}).ok());
+  for (const double t : {last - 2 * gap, last - gap, last - 0.5 * gap, last}) {
+    const TrajectorySample sample = parsed->plan.Sample(t);
+    EXPECT_TRUE(std::isfinite(sample.positions[0]) && std::isfinite(sample.velocities[0])) << t;
+  }
+  EXPECT_EQ(parsed->plan.Sample(last).positions[0], -1e4);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::node

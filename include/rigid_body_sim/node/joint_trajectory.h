@@ -26,10 +26,14 @@ class JointTrajectory {
   // s: the least time between two points, and from the start to the first
   // point unless it is at 0. ROS trajectories come at most at some kHz.
   static constexpr double kMinPointGap = 1e-6;
+  // s: the latest time_from_start, the span of a ROS duration (2^31 s).
+  // It also keeps kMinPointGap above the doubles' spacing (4.8e-7 s at
+  // 2^31 s), so two points never share a time, and h * v in Sample finite.
+  static constexpr double kMaxPointTime = 2147483648.0;
 
   // `start` holds the joints' positions and velocities when the trajectory
-  // begins (time 0); `points` must have times increasing by at least
-  // kMinPointGap (a first point at time 0 replaces the start) and one
+  // begins (time 0); `points` must have times up to kMaxPointTime increasing
+  // by at least kMinPointGap (a first point at time 0 replaces the start) and one
   // finite value per joint. Velocities left out are estimated: the mean of the slopes to
   // the neighbouring points, 0 at the last point.
   static physics::Result<JointTrajectory> Make(const TrajectoryPoint& start,
