@@ -97,9 +97,11 @@ test-tsan: deps
 	  cat $(WS_TSAN)/tsan.*; echo "[test-tsan] ThreadSanitizer reported a race" >&2; exit 1; fi
 	@echo "[test-tsan] no ThreadSanitizer reports"
 
-# `make sanitize`: the ROS-free gtests under ASan and UBSan (test-sanitize),
-# then every node test with the node, its mesh helper and the test clients
-# built under ASan and UBSan in a workspace of their own. Python tests drive
+# `make sanitize`: every gtest of the ROS-free libraries (rbs_core_tests)
+# and every node test, with the libraries, the node, its mesh helper and the
+# test clients built once under ASan and UBSan in a workspace of their own
+# (asserts on: no NDEBUG; the libraries compiled once for both, which
+# test-sanitize's separate build did twice). Python tests drive
 # the instrumented node. Any sanitizer report (a leak at exit included) fails
 # the target; the reports are in build/.ws-asan/asan.*. Allocations the
 # node's limits refuse come back as null instead of an ASan abort
@@ -109,13 +111,13 @@ test-tsan: deps
 WS_ASAN := $(ROOT)/build/.ws-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 SANITIZE_TARGETS := rigid_body_sim_node rigid_body_sim_mesh_helper rigid_body_sim_generate_messages \
-  rigid_body_sim_gencfg node_conversion_test \
+  rigid_body_sim_gencfg rbs_core_tests node_conversion_test \
   node_services_test node_falling_box_test node_contacts_test node_concurrency_test \
   node_hostile_test node_hostile_joints_test node_time_stamps_test
-sanitize: test-sanitize
+sanitize: deps
 	$(MAKE) --no-print-directory ws-links WS=$(WS_ASAN)
-	catkin_make -C $(WS_ASAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -DEIGEN_NO_DEBUG -Wno-maybe-uninitialized" \
+	catkin_make -C $(WS_ASAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=None \
+	  -DCMAKE_CXX_FLAGS="-O2 -g $(SANITIZE_FLAGS) -DEIGEN_NO_DEBUG -Wno-maybe-uninitialized" \
 	  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) \
 	  $(SANITIZE_TARGETS) -j$(JOBS) 2>&1 \
 	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|[Ee]rror|warning|undefined' || true)
@@ -124,7 +126,7 @@ sanitize: test-sanitize
 	  ASAN_OPTIONS="detect_leaks=1 allocator_may_return_null=1 log_path=$(WS_ASAN)/asan" \
 	  LSAN_OPTIONS="suppressions=$(ROOT)/test/node/lsan.supp" \
 	  UBSAN_OPTIONS="print_stacktrace=1 log_path=$(WS_ASAN)/asan" \
-	  ctest --output-on-failure -R 'rostest|node_conversion' -E node_scale
+	  ctest --output-on-failure -R 'gtest|rostest' -E node_scale
 	@if ls $(WS_ASAN)/asan.* > /dev/null 2>&1; then \
 	  cat $(WS_ASAN)/asan.*; echo "[sanitize] a sanitizer reported an error" >&2; exit 1; fi
 	@echo "[sanitize] no AddressSanitizer or UndefinedBehaviorSanitizer reports"

@@ -4,7 +4,11 @@
 // 1000 times heavier (chain_30's whip), swinging under gravity from 0.3 rad
 // per joint at dt = 1/240 s; one thread.
 //
-// Usage: chain_scaling_bench [STEPS [JOINTS...]]   (default 480; 30 50 64 100)
+// With --uniform, every rod weighs the same (no whip): the plain hanging
+// chain.
+//
+// Usage: chain_scaling_bench [--uniform] [STEPS [JOINTS...]]
+//        (default 480; 30 50 64 100)
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -37,7 +41,7 @@ LinkDef Rod(double mass) {
   return link;
 }
 
-ArticulationDef Chain(int joints) {
+ArticulationDef Chain(int joints, double tip_ratio) {
   ArticulationDef def;
   def.fixed_base = true;
   def.world_from_base.translation = Vec3(0, 0, 100);
@@ -46,7 +50,7 @@ ArticulationDef Chain(int joints) {
   base.mass_properties.inertia_about_com = Mat3::Identity() * 0.01;
   def.links.push_back(base);
   for (int i = 1; i <= joints; ++i) {
-    def.links.push_back(Rod(i == joints ? 1000.0 : 1.0));
+    def.links.push_back(Rod(i == joints ? tip_ratio : 1.0));
     JointDef joint;
     joint.name = "j" + std::to_string(i);
     joint.type = JointType::kContinuous;
@@ -63,17 +67,20 @@ ArticulationDef Chain(int joints) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int steps = argc > 1 ? std::atoi(argv[1]) : 480;
+  int first = 1;
+  const bool uniform = argc > 1 && std::string(argv[1]) == "--uniform";
+  if (uniform) ++first;
+  const int steps = argc > first ? std::atoi(argv[first]) : 480;
   std::vector<int> sizes;
-  for (int i = 2; i < argc; ++i) sizes.push_back(std::atoi(argv[i]));
+  for (int i = first + 1; i < argc; ++i) sizes.push_back(std::atoi(argv[i]));
   if (sizes.empty()) sizes = {30, 50, 64, 100};
-  std::printf("movable joints, mean ms/step, worst ms/step (%d steps, heavy tip, dt 1/240 s)\n",
-              steps);
+  std::printf("movable joints, mean ms/step, worst ms/step (%d steps, %s, dt 1/240 s)\n", steps,
+              uniform ? "uniform rods" : "heavy tip");
   for (const int joints : sizes) {
     WorldSettings settings;
     settings.time_step = 1.0 / 240.0;
     World world(settings);
-    if (!world.CreateArticulation(Chain(joints)).ok()) {
+    if (!world.CreateArticulation(Chain(joints, uniform ? 1.0 : 1000.0)).ok()) {
       std::printf("%d: refused\n", joints);
       continue;
     }

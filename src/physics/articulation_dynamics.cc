@@ -56,16 +56,17 @@ double JointVelocity(const ArticulationModel& model, const ArticulationState& st
 // omega_c = omega_p + s qdot, v_c = v_p + omega_p x (c_c - c_p) + (s x
 // (c_c - p) or s) qdot, and the same recursion for the Jacobian columns.
 void ComputeKinematics(const ArticulationModel& model, const ArticulationState& state,
-                       ArticulationKinematics* k) {
+                       ArticulationKinematics* k, KinematicsParts parts) {
   const std::size_t link_count = model.links.size();
   const std::size_t joint_count = model.joints.size();
   const int n = model.DofCount();
+  const bool jacobians = parts == KinematicsParts::kWithJacobians;
   k->world_from_link.resize(link_count);
   k->com_world.resize(link_count);
   k->inertia_world.resize(link_count);
   k->linear_velocity.resize(link_count);
   k->angular_velocity.resize(link_count);
-  k->jacobian.resize(link_count);
+  k->jacobian.resize(jacobians ? link_count : 0);
   k->joint_axis_world.resize(joint_count);
   k->joint_anchor_world.resize(joint_count);
   k->joint_position.resize(joint_count);
@@ -75,10 +76,18 @@ void ComputeKinematics(const ArticulationModel& model, const ArticulationState& 
   const Mat3 base_rotation = state.base_rotation.toRotationMatrix();
   k->world_from_link[0] = Pose{state.base_com - base_rotation * base.com_link, state.base_rotation};
   k->com_world[0] = state.base_com;
-  k->jacobian[0].setZero(6, n);
+  k->linear_velocity[0].setZero();
+  k->angular_velocity[0].setZero();
   if (model.base_dofs == 6) {
-    k->jacobian[0].block<3, 3>(0, 0).setIdentity();
-    k->jacobian[0].block<3, 3>(3, 3).setIdentity();
+    k->linear_velocity[0] = state.u.head<3>();
+    k->angular_velocity[0] = state.u.segment<3>(3);
+  }
+  if (jacobians) {
+    k->jacobian[0].setZero(6, n);
+    if (model.base_dofs == 6) {
+      k->jacobian[0].block<3, 3>(0, 0).setIdentity();
+      k->jacobian[0].block<3, 3>(3, 3).setIdentity();
+    }
   }
   for (std::size_t j = 0; j < joint_count; ++j) {
     const ArticulationJoint& joint = model.joints[j];
@@ -89,31 +98,36 @@ void ComputeKinematics(const ArticulationModel& model, const ArticulationState& 
     k->world_from_link[child] = world_from_joint * JointMotion(joint.def, position);
     k->com_world[child] = k->world_from_link[child] * model.links[child].com_link;
     const Vec3 axis = world_from_joint.rotation * joint.def.axis;
+    const Vec3 lever = k->com_world[child] - world_from_joint.translation;
+    const Vec3 reach = k->com_world[child] - k->com_world[parent];
+    const double velocity = JointVelocity(model, state, static_cast<int>(j));
+    const bool slides = joint.def.type == JointType::kPrismatic;
     k->joint_axis_world[j] = axis;
     k->joint_anchor_world[j] = world_from_joint.translation;
     k->joint_position[j] = position;
-    k->joint_velocity[j] = JointVelocity(model, state, static_cast<int>(j));
-
+    k->joint_velocity[j] = velocity;
+    const Vec3& w_p = k->angular_velocity[parent];
+    k->angular_velocity[child] = slides ? w_p : Vec3(w_p + axis * velocity);
+    k->linear_velocity[child] = k->linear_velocity[parent] + w_p.cross(reach) +
+                                (slides ? axis : Vec3(axis.cross(lever))) * velocity;
+    if (!jacobians) continue;
     // J_c = [J_v,p - [c_c - c_p]x J_w,p ; J_w,p] plus the joint's column.
     const JacobianRows& jp = k->jacobian[parent];
     JacobianRows& jc = k->jacobian[child];
     jc = jp;
-    jc.topRows<3>() -= Skew(k->com_world[child] - k->com_world[parent]) * jp.bottomRows<3>();
+    jc.topRows<3>() -= Skew(reach) * jp.bottomRows<3>();
     double factor = 1.0;
     const int column = model.base_dofs + DrivingDof(model, static_cast<int>(j), &factor);
-    if (joint.def.type == JointType::kPrismatic) {
+    if (slides) {
       jc.block<3, 1>(0, column) += factor * axis;
     } else {
-      jc.block<3, 1>(0, column) +=
-          factor * axis.cross(k->com_world[child] - world_from_joint.translation);
+      jc.block<3, 1>(0, column) += factor * axis.cross(lever);
       jc.block<3, 1>(3, column) += factor * axis;
     }
   }
   for (std::size_t i = 0; i < link_count; ++i) {
     const Mat3 rotation = k->world_from_link[i].rotation.toRotationMatrix();
     k->inertia_world[i] = rotation * model.links[i].inertia_link * rotation.transpose();
-    k->linear_velocity[i] = k->jacobian[i].topRows<3>() * state.u;
-    k->angular_velocity[i] = k->jacobian[i].bottomRows<3>() * state.u;
   }
 }
 
@@ -325,11 +339,12 @@ namespace {
 // derivative is carried as omega and applied by Advance.
 Eigen::VectorXd Acceleration(const ArticulationModel& model, const ArticulationState& state,
                              const Vec3& gravity, const Eigen::VectorXd& joint_efforts) {
-  ArticulationKinematics kinematics;
-  ComputeKinematics(model, state, &kinematics);
-  JointSpaceDynamics dynamics;
-  ComputeDynamics(model, state, kinematics, gravity, joint_efforts, &dynamics);
-  return dynamics.mass.llt().solve(dynamics.force);
+  thread_local ArticulationKinematics kinematics;
+  thread_local ArticulatedBodyScratch scratch;
+  ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
+  Eigen::VectorXd acceleration;
+  ForwardDynamics({model, state, kinematics, gravity, joint_efforts}, &scratch, &acceleration);
+  return acceleration;
 }
 
 }  // namespace
@@ -341,9 +356,11 @@ Eigen::VectorXd Acceleration(const ArticulationModel& model, const ArticulationS
 // keeps it a unit quaternion.
 ArticulationState StepFreeMotion(const ArticulationModel& model, const ArticulationState& state,
                                  const Vec3& gravity, const Eigen::VectorXd& joint_efforts,
-                                 double dt) {
+                                 double dt, const Eigen::VectorXd* start_acceleration) {
   const Eigen::VectorXd& u1 = state.u;
-  const Eigen::VectorXd a1 = Acceleration(model, state, gravity, joint_efforts);
+  const Eigen::VectorXd a1 = start_acceleration != nullptr
+                                 ? *start_acceleration
+                                 : Acceleration(model, state, gravity, joint_efforts);
   ArticulationState s2 = Advance(model, state, u1, 0.5 * dt);
   s2.u = u1 + 0.5 * dt * a1;
   const Eigen::VectorXd a2 = Acceleration(model, s2, gravity, joint_efforts);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/StdVector>
 
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/types.h"
@@ -78,10 +79,15 @@ struct ArticulationKinematics {
 double JointPosition(const ArticulationModel& model, const ArticulationState& state, int joint);
 double JointVelocity(const ArticulationModel& model, const ArticulationState& state, int joint);
 
-// Forward kinematics, velocities and Jacobians by one pass from the base to
-// the leaves.
+// What ComputeKinematics fills: the links' poses and velocities always
+// (O(n)), their dense Jacobians (6 x dofs each, O(n^2)) only for a row
+// solve that needs them.
+enum class KinematicsParts : std::uint8_t { kPosesAndVelocities, kWithJacobians };
+
+// Forward kinematics and velocities, and the Jacobians if asked, by one
+// pass from the base to the leaves. `jacobian` is left empty without them.
 void ComputeKinematics(const ArticulationModel& model, const ArticulationState& state,
-                       ArticulationKinematics* kinematics);
+                       ArticulationKinematics* kinematics, KinematicsParts parts);
 
 // The joint-space inertia M = sum_i J_i^T diag(m_i 1, I_i) J_i by the
 // composite-rigid-body algorithm (Featherstone 2008, "Rigid Body Dynamics
@@ -111,16 +117,68 @@ void ComputeDynamics(const ArticulationModel& model, const ArticulationState& st
                      const ArticulationKinematics& kinematics, const Vec3& gravity,
                      const Eigen::VectorXd& joint_efforts, JointSpaceDynamics* dynamics);
 
+// One forward dynamics problem: u' = (M + h B)^-1 Q for the state, its
+// kinematics (poses and velocities), and h = damping_step (0: the damping
+// explicit in Q only; h > 0: also implicit over a step of h, as the
+// velocity-level step takes it).
+struct ForwardDynamicsInput {
+  const ArticulationModel& model;
+  const ArticulationState& state;
+  const ArticulationKinematics& kinematics;
+  const Vec3& gravity;                   // m/s^2
+  const Eigen::VectorXd& joint_efforts;  // per dof, N m or N
+  double damping_step = 0.0;             // s
+};
+
+// The articulated-body algorithm's buffers, kept from call to call so that
+// a step allocates nothing once they have their model's size.
+struct ArticulatedBodyScratch {
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Vec3 origin = Vec3::Zero();                                 // O, m, world
+  std::vector<Mat6, Eigen::aligned_allocator<Mat6>> inertia;  // per link, I^A about O
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> bias;     // per link, p^A
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> velocity;
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> product;           // c_i
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> acceleration;      // a_i
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> subspace;          // per joint, S
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> inertia_subspace;  // U = I^A S
+  std::vector<double> pivot;                                           // D
+  std::vector<double> remainder;                                       // u
+  ArticulationKinematics kinematics;  // the composite-rigid-body path's
+  void Prepare(const ForwardDynamicsInput& in);
+};
+
+// Whether the articulated-body algorithm applies: a tree whose every joint
+// has its own dof. A mimic joint couples two dofs, which the recursion
+// cannot express; such models take the composite-rigid-body path.
+bool ArticulatedBodyApplies(const ArticulationModel& model);
+
+// u' by the articulated-body algorithm (Featherstone 2008, section 7.3),
+// O(n) (articulated_body_algorithm.cc). Only when ArticulatedBodyApplies.
+void ArticulatedBodyForwardDynamics(const ForwardDynamicsInput& in, ArticulatedBodyScratch* scratch,
+                                    Eigen::VectorXd* acceleration);
+// u' = (M + h B)^-1 Q with M by the composite-rigid-body algorithm and a
+// dense Cholesky factor, O(n d + n^3): any model, mimics included; the
+// reference the tests compare the articulated-body algorithm with.
+void CompositeRigidBodyForwardDynamics(const ForwardDynamicsInput& in,
+                                       ArticulationKinematics* kinematics,
+                                       Eigen::VectorXd* acceleration);
+// The first where it applies, else the second.
+void ForwardDynamics(const ForwardDynamicsInput& in, ArticulatedBodyScratch* scratch,
+                     Eigen::VectorXd* acceleration);
+
 // The state advanced by h with velocities u: joint positions by h u, the
 // base by h v and a turn of h omega.
 ArticulationState Advance(const ArticulationModel& model, const ArticulationState& state,
                           const Eigen::VectorXd& u, double h);
 
 // One step of the unconstrained motion by classical Runge-Kutta (fourth
-// order) on (q, u), efforts held constant over the step.
+// order) on (q, u), efforts held constant over the step. `start_acceleration`,
+// when given, is u' at `state` (the first stage's, computed already).
 ArticulationState StepFreeMotion(const ArticulationModel& model, const ArticulationState& state,
                                  const Vec3& gravity, const Eigen::VectorXd& joint_efforts,
-                                 double dt);
+                                 double dt, const Eigen::VectorXd* start_acceleration = nullptr);
 
 // One free step's inputs.
 struct FreeMotionStep {
@@ -129,6 +187,9 @@ struct FreeMotionStep {
   const Vec3& gravity;                   // m/s^2
   const Eigen::VectorXd& joint_efforts;  // per dof, N m or N
   double dt;                             // s
+  // u' at `state` with the damping explicit, when the caller has it: the
+  // first RK4 stage then reuses it instead of computing it again.
+  const Eigen::VectorXd* start_acceleration = nullptr;
 };
 
 // How an articulation's free steps are split, kept from step to step.

@@ -41,7 +41,7 @@ struct Energy {
 Energy ComputeEnergy(const ArticulationModel& model, const ArticulationState& state,
                      const Vec3& gravity) {
   ArticulationKinematics k;
-  ComputeKinematics(model, state, &k);
+  ComputeKinematics(model, state, &k, KinematicsParts::kPosesAndVelocities);
   Energy energy;
   for (std::size_t i = 0; i < model.links.size(); ++i) {
     const double mass = model.links[i].mass;
@@ -67,7 +67,8 @@ ArticulationState StepInParts(const FreeMotionStep& step, int parts) {
   ArticulationState state = step.state;
   const double h = step.dt / parts;
   for (int part = 0; part < parts; ++part) {
-    state = StepFreeMotion(step.model, state, step.gravity, step.joint_efforts, h);
+    state = StepFreeMotion(step.model, state, step.gravity, step.joint_efforts, h,
+                           part == 0 ? step.start_acceleration : nullptr);
   }
   return state;
 }

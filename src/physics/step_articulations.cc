@@ -64,11 +64,14 @@ Eigen::VectorXd CommandedEfforts(const ArticulationModel& model) {
 // step. Such an articulation takes the implicit velocity-level step. The
 // joint-space inertia's norm, compared before, is dominated by a floating
 // base's mass and missed it.
-bool DampingIsStiff(const ArticulationModel& model, const Eigen::MatrixXd& mass, double dt) {
+bool DampingIsStiff(const ArticulationModel& model, const ArticulationKinematics& kinematics,
+                    double dt) {
   constexpr double kMaxRate = 0.5;  // dt lambda
   bool damped = false;
   for (const ArticulationJoint& joint : model.joints) damped = damped || joint.def.damping > 0.0;
   if (!damped) return false;
+  Eigen::MatrixXd mass;
+  JointSpaceInertia(model, kinematics, &mass);
   const Eigen::MatrixXd inverse =
       mass.llt().solve(Eigen::MatrixXd::Identity(mass.rows(), mass.cols()));
   double rate = 0.0;
@@ -78,6 +81,48 @@ bool DampingIsStiff(const ArticulationModel& model, const Eigen::MatrixXd& mass,
     rate += joint.def.damping * inverse(column, column);
   }
   return dt * rate > kMaxRate;
+}
+
+// Per movable joint: its limits when the free step would reach them, its
+// speed limit when the free step would exceed it, its friction, and its
+// command's servo or motor. Efforts commanded directly are in Q already.
+void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, double dt,
+                 const ServoGains& gains, std::vector<JointRowSpec>* rows) {
+  rows->clear();
+  const ArticulationModel& model = entry.model;
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    const ArticulationJoint& joint = model.joints[j];
+    if (joint.dof < 0) continue;
+    const JointDef& def = joint.def;
+    const int column = model.base_dofs + joint.dof;
+    const double q = entry.state.q[joint.dof];
+    const double u = u_free[column];
+    const double reach = dt * (std::abs(u) + std::abs(u - entry.state.u[column])) + 1e-12;
+    auto add = [&](double sign, RowKind kind, double target, double bound, double softness) {
+      rows->push_back({static_cast<int>(j), column, sign, kind, target, bound, softness});
+    };
+    if (q + dt * u < def.lower + reach) add(1.0, RowKind::kNormal, (def.lower - q) / dt, 0.0, 0.0);
+    if (q + dt * u > def.upper - reach) add(-1.0, RowKind::kNormal, (q - def.upper) / dt, 0.0, 0.0);
+    if (std::abs(u) > def.velocity_limit) {
+      add(u > 0.0 ? -1.0 : 1.0, RowKind::kNormal, -def.velocity_limit, 0.0, 0.0);
+    }
+    if (def.friction > 0.0) add(1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
+    // Each of the joints the dof moves may exert its own limit.
+    const double effort_bound = joint.effort_scale * def.effort_limit * dt;
+    if (joint.command.mode == JointCommandMode::kVelocity) {
+      add(1.0, RowKind::kBounded, joint.command.velocity, effort_bound, 0.0);
+    } else if (joint.command.mode == JointCommandMode::kPosition) {
+      // The implicit spring-damper as a soft row (Catto 2011, "Soft
+      // Constraints"): v + gamma lambda = v_cmd - beta (q - q_cmd) / dt with
+      // beta = dt k / (dt k + c) and gamma = 1 / (dt (dt k + c)); its steady
+      // error under a load tau is tau / k.
+      const double kc = dt * gains.stiffness + gains.damping;
+      const double beta = dt * gains.stiffness / kc;
+      const double gamma = 1.0 / (dt * kc);
+      const double target = joint.command.velocity - beta * (q - joint.command.position) / dt;
+      add(1.0, RowKind::kBounded, target, effort_bound, gamma);
+    }
+  }
 }
 
 }  // namespace
@@ -103,58 +148,30 @@ void WorldImpl::SplitLinkPairs(const std::vector<ShapePairContact*>& pairs) {
   }
 }
 
-// Per movable joint: its limits when the free step would reach them, its
-// speed limit when the free step would exceed it, its friction, and its
-// command's servo or motor. Efforts commanded directly are in Q already.
-void WorldImpl::AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free,
-                                    double dt) {
-  const ArticulationEntry& entry = articulations_[index];
-  const ArticulationModel& model = entry.model;
-  const int n = model.DofCount();
-  for (const ArticulationJoint& joint : model.joints) {
-    if (joint.dof < 0) continue;
-    const JointDef& def = joint.def;
-    const int column = model.base_dofs + joint.dof;
-    const double q = entry.state.q[joint.dof];
-    const double u = u_free[column];
-    const double reach = dt * (std::abs(u) + std::abs(u - entry.state.u[column])) + 1e-12;
-    auto add = [&](double sign, RowKind kind, double target, double bound, double softness) {
-      ConstraintRow row;
-      row.articulation = static_cast<int>(index);
-      row.joint = static_cast<int>(&joint - model.joints.data());
-      row.joint_sign = sign;
-      row.a = articulation_solver_.ArticulationSide(slot, Unit(n, column, sign));
-      row.kind = kind;
-      row.target = target;
-      row.lower = -bound;
-      row.upper = bound;
-      row.softness = softness;
-      articulation_solver_.AddRow(std::move(row));
-    };
-    if (q + dt * u < def.lower + reach) add(1.0, RowKind::kNormal, (def.lower - q) / dt, 0.0, 0.0);
-    if (q + dt * u > def.upper - reach) add(-1.0, RowKind::kNormal, (q - def.upper) / dt, 0.0, 0.0);
-    if (std::abs(u) > def.velocity_limit) {
-      add(u > 0.0 ? -1.0 : 1.0, RowKind::kNormal, -def.velocity_limit, 0.0, 0.0);
-    }
-    if (def.friction > 0.0) add(1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
-    // Each of the joints the dof moves may exert its own limit.
-    const double effort_bound = joint.effort_scale * def.effort_limit * dt;
-    if (joint.command.mode == JointCommandMode::kVelocity) {
-      add(1.0, RowKind::kBounded, joint.command.velocity, effort_bound, 0.0);
-    } else if (joint.command.mode == JointCommandMode::kPosition) {
-      // The implicit spring-damper as a soft row (Catto 2011, "Soft
-      // Constraints"): v + gamma lambda = v_cmd - beta (q - q_cmd) / dt with
-      // beta = dt k / (dt k + c) and gamma = 1 / (dt (dt k + c)); its steady
-      // error under a load tau is tau / k.
-      const double kc = dt * entry.gains.stiffness + entry.gains.damping;
-      const double beta = dt * entry.gains.stiffness / kc;
-      const double gamma = 1.0 / (dt * kc);
-      const double target = joint.command.velocity - beta * (q - joint.command.position) / dt;
-      add(1.0, RowKind::kBounded, target, effort_bound, gamma);
-    }
+void WorldImpl::AddArticulationRows(std::uint32_t index, int slot,
+                                    const std::vector<JointRowSpec>& specs) {
+  const int n = articulations_[index].model.DofCount();
+  for (const JointRowSpec& spec : specs) {
+    ConstraintRow row;
+    row.articulation = static_cast<int>(index);
+    row.joint = spec.joint;
+    row.joint_sign = spec.sign;
+    row.a = articulation_solver_.ArticulationSide(slot, Unit(n, spec.column, spec.sign));
+    row.kind = spec.kind;
+    row.target = spec.target;
+    row.lower = -spec.bound;
+    row.upper = spec.bound;
+    row.softness = spec.softness;
+    articulation_solver_.AddRow(std::move(row));
   }
 }
 
+// Each articulation's velocity without rows, u* = u + dt (M + dt B)^-1 Q,
+// comes from the articulated-body algorithm in O(n) (the damping B
+// implicit as an armature). Only an articulation that has rows this step
+// (a limit reached, a servo, friction, a contact) or stiff damping builds
+// its joint-space inertia M for the row solve, and only one with contacts
+// its links' Jacobians; the others take the free RK4 step.
 void WorldImpl::SolveArticulations(double dt) {
   if (articulations_.empty()) return;
   articulation_solver_.Reset();
@@ -166,6 +183,8 @@ void WorldImpl::SolveArticulations(double dt) {
   }
   std::vector<int> slot(articulations_.size(), -1);
   std::vector<ArticulationKinematics> kinematics(articulations_.size());
+  std::vector<JointRowSpec> joint_rows;
+  Eigen::VectorXd acceleration;
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     ArticulationEntry& entry = articulations_[i];
     if (!entry.in_use) continue;
@@ -176,31 +195,34 @@ void WorldImpl::SolveArticulations(double dt) {
     }
     const Eigen::VectorXd efforts = CommandedEfforts(model);
     ArticulationKinematics& k = kinematics[i];
-    ComputeKinematics(model, entry.state, &k);
-    JointSpaceDynamics dynamics;
-    ComputeDynamics(model, entry.state, k, settings_.gravity, efforts, &dynamics);
-    Eigen::MatrixXd mass = dynamics.mass;
+    ComputeKinematics(
+        model, entry.state, &k,
+        touched[i] ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
+    ForwardDynamics({model, entry.state, k, settings_.gravity, efforts, dt}, &articulation_scratch_,
+                    &acceleration);
+    const Eigen::VectorXd u_free = entry.state.u + dt * acceleration;
+    JointRowsOf(entry, u_free, dt, entry.gains, &joint_rows);
+    for (ArticulationJoint& joint : model.joints) {
+      joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
+    }
+    if (joint_rows.empty() && !touched[i] && !DampingIsStiff(model, k, dt)) {
+      // Without damping, u* came from the explicit dynamics: the first
+      // RK4 stage's u'.
+      const bool damped = std::any_of(model.joints.begin(), model.joints.end(),
+                                      [](const ArticulationJoint& j) { return j.def.damping > 0; });
+      entry.next = StepFreeMotionBalanced(
+          {model, entry.state, settings_.gravity, efforts, dt, damped ? nullptr : &acceleration},
+          &entry.free_motion_split);
+      continue;
+    }
+    Eigen::MatrixXd mass;
+    JointSpaceInertia(model, k, &mass);
     for (const ArticulationJoint& joint : model.joints) {
       if (joint.dof >= 0)
         mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += dt * joint.def.damping;
     }
-    // Damping explicit in Q, implicit in the mass: (M + dt B) u* = M u + dt Q.
-    const Eigen::VectorXd u_free = entry.state.u + mass.llt().solve(dt * dynamics.force);
-    const std::size_t rows_before = articulation_solver_.rows().size();
-    const int candidate = articulation_solver_.AddArticulation(u_free, mass);
-    AddArticulationRows(i, candidate, u_free, dt);
-    const bool has_rows = articulation_solver_.rows().size() > rows_before;
-    for (ArticulationJoint& joint : model.joints) {
-      joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
-    }
-    // The damping test inverts M, so it runs only when nothing else has
-    // chosen the velocity-level step.
-    if (has_rows || touched[i] || DampingIsStiff(model, dynamics.mass, dt)) {
-      slot[i] = candidate;
-    } else {
-      entry.next = StepFreeMotionBalanced({model, entry.state, settings_.gravity, efforts, dt},
-                                          &entry.free_motion_split);
-    }
+    slot[i] = articulation_solver_.AddArticulation(u_free, mass);
+    AddArticulationRows(i, slot[i], joint_rows);
   }
   AddLinkContactRows(dt, slot, kinematics);
   articulation_solver_.Solve(kMaxSweeps, kSweepTolerance);

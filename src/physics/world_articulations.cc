@@ -155,7 +155,7 @@ Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def)
   entry.next = state;
 
   ArticulationKinematics k;
-  ComputeKinematics(entry.model, state, &k);
+  ComputeKinematics(entry.model, state, &k, KinematicsParts::kPosesAndVelocities);
   std::uint32_t index = 0;
   while (index < articulations_.size() && articulations_[index].in_use) ++index;
   if (index == articulations_.size()) articulations_.emplace_back();
@@ -310,7 +310,7 @@ Status WorldImpl::MoveArticulation(std::uint32_t index, const Pose& world_from_l
                                    int link) {
   ArticulationEntry& entry = articulations_[index];
   ArticulationKinematics k;
-  ComputeKinematics(entry.model, entry.state, &k);
+  ComputeKinematics(entry.model, entry.state, &k, KinematicsParts::kPosesAndVelocities);
   const Pose world_from_base =
       world_from_link * k.world_from_link[link].Inverse() * k.world_from_link[0];
   ArticulationState state = entry.state;
@@ -333,7 +333,7 @@ Status WorldImpl::MoveArticulation(std::uint32_t index, const Pose& world_from_l
 void WorldImpl::PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart) {
   const ArticulationEntry& entry = articulations_[index];
   ArticulationKinematics k;
-  ComputeKinematics(entry.model, state, &k);
+  ComputeKinematics(entry.model, state, &k, KinematicsParts::kPosesAndVelocities);
   for (std::size_t i = 0; i < entry.model.links.size(); ++i) {
     const std::uint32_t body_index = entry.model.links[i].body;
     Body& body = bodies_[body_index];

@@ -56,6 +56,18 @@ void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
 
 // An articulation in the world: its model, its state, and the state its
 // constraint solve chose for the end of the step.
+// One joint row before it has a solver slot: the row on its dof `column`
+// (sign: +1 pushes the joint forward), as ConstraintRow's fields.
+struct JointRowSpec {
+  int joint = -1;
+  int column = 0;
+  double sign = 1.0;
+  RowKind kind = RowKind::kBounded;
+  double target = 0.0;  // velocity units of the row
+  double bound = 0.0;   // |impulse| <= bound (kBounded)
+  double softness = 0.0;
+};
+
 struct ArticulationEntry {
   ArticulationModel model;
   ArticulationState state;
@@ -177,7 +189,7 @@ class WorldImpl {
   // solver's) and those with a link (the articulation solve's).
   void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
   void SolveArticulations(double dt);
-  void AddArticulationRows(std::uint32_t index, int slot, const Eigen::VectorXd& u_free, double dt);
+  void AddArticulationRows(std::uint32_t index, int slot, const std::vector<JointRowSpec>& rows);
   void CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation);
   void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
   void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
@@ -222,7 +234,8 @@ class WorldImpl {
   StepProfile last_step_profile_;
   std::vector<ArticulationEntry> articulations_;
   ArticulationSolver articulation_solver_;
-  std::vector<ShapePairContact*> rigid_pairs_;  // SplitLinkPairs'
+  ArticulatedBodyScratch articulation_scratch_;  // SolveArticulations'
+  std::vector<ShapePairContact*> rigid_pairs_;   // SplitLinkPairs'
   std::vector<ShapePairContact*> link_pairs_;
   // Per link pair, the index of its first normal row, or -1.
   std::vector<int> link_pair_rows_;

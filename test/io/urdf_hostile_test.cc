@@ -119,17 +119,21 @@ std::string HingeChain(int joints) {
   return xml + "</robot>";
 }
 
-// The articulation's step costs about n^3 in its movable joints, so their
-// count has a limit of its own (64 by default), met before anything is
-// built; a model whose joints are welded has none to move and is not held
-// to it.
+// The articulation's step grows with its movable joints and holds the
+// world lock, so their count has a limit of its own
+// (kDefaultMaxJointsPerModel by default), met before anything is built; a
+// model whose joints are welded has none to move and is not held to it.
 TEST(UrdfHostileTest, MovableJointsBeyondTheLimitAreRefusedByName) {
   UrdfLoadOptions options;
   options.articulate = true;
-  ExpectRefused(HingeChain(65), {"65 movable joints", "max_joints_per_model 64"}, options);
-  const Result<LoadedModel> at_limit = LoadUrdfString(HingeChain(64), options);
+  const int limit = kDefaultMaxJointsPerModel;
+  ExpectRefused(HingeChain(limit + 1),
+                {std::to_string(limit + 1) + " movable joints",
+                 "max_joints_per_model " + std::to_string(limit)},
+                options);
+  const Result<LoadedModel> at_limit = LoadUrdfString(HingeChain(limit), options);
   ASSERT_TRUE(at_limit.ok()) << at_limit.message();
-  EXPECT_EQ(at_limit->joints.size(), 64u);
+  EXPECT_EQ(at_limit->joints.size(), static_cast<std::size_t>(limit));
   options.max_joints = 65;
   EXPECT_TRUE(LoadUrdfString(HingeChain(65), options).ok());
   options.max_joints = 64;

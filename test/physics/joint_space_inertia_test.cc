@@ -29,9 +29,9 @@ Quat RandomRotation(std::mt19937* random) {
 }
 
 // A tree of `links` links, each joint's parent drawn from the links before
-// its child; every fourth joint past the first mimics an earlier joint
-// that mimics none.
-ArticulationModel RandomTree(int links, bool floating, std::mt19937* random) {
+// its child; with `mimics`, every fourth joint past the first mimics an
+// earlier joint that mimics none.
+ArticulationModel RandomTree(int links, bool floating, std::mt19937* random, bool mimics = true) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   ArticulationModel model;
   model.fixed_base = !floating;
@@ -54,9 +54,10 @@ ArticulationModel RandomTree(int links, bool floating, std::mt19937* random) {
     joint.def.parent_from_joint = Pose{RandomVector(random, 0.5), RandomRotation(random)};
     joint.def.axis = RandomVector(random, 1.0).normalized();
     const int index = static_cast<int>(model.joints.size());
-    if (index > 0 && index % 4 == 0) {
-      joint.def.mimic_joint = leaders[std::uniform_int_distribution<std::size_t>(
-          0, leaders.size() - 1)(*random)];
+    joint.def.damping = unit(*random) < 0.5 ? 0.0 : 2.0 * unit(*random);
+    if (mimics && index > 0 && index % 4 == 0) {
+      joint.def.mimic_joint =
+          leaders[std::uniform_int_distribution<std::size_t>(0, leaders.size() - 1)(*random)];
       joint.def.mimic_multiplier = -2.0 + 4.0 * unit(*random);
     } else {
       joint.dof = model.joint_dofs++;
@@ -76,7 +77,8 @@ ArticulationState RandomState(const ArticulationModel& model, const Vec3& where,
   std::uniform_real_distribution<double> coordinate(-2.0, 2.0);
   state.q.resize(model.joint_dofs);
   for (Eigen::Index k = 0; k < state.q.size(); ++k) state.q[k] = coordinate(*random);
-  state.u = Eigen::VectorXd::Zero(model.DofCount());
+  state.u.resize(model.DofCount());
+  for (Eigen::Index k = 0; k < state.u.size(); ++k) state.u[k] = coordinate(*random);
   return state;
 }
 
@@ -94,7 +96,7 @@ TEST(JointSpaceInertiaTest, CompositeBodiesMatchTheSumOverJacobiansOnRandomTrees
         const ArticulationModel model = RandomTree(links, floating, &random);
         const ArticulationState state = RandomState(model, where, &random);
         ArticulationKinematics kinematics;
-        ComputeKinematics(model, state, &kinematics);
+        ComputeKinematics(model, state, &kinematics, KinematicsParts::kWithJacobians);
         Eigen::MatrixXd fast;
         Eigen::MatrixXd reference;
         JointSpaceInertia(model, kinematics, &fast);
@@ -110,6 +112,65 @@ TEST(JointSpaceInertiaTest, CompositeBodiesMatchTheSumOverJacobiansOnRandomTrees
     }
   }
   EXPECT_EQ(compared, 20);
+}
+
+// The articulated-body algorithm's u' = (M + h B)^-1 Q against the
+// composite-rigid-body M and a dense Cholesky solve, on random trees without
+// mimics: turning and sliding joints with damping, moving states, efforts,
+// wrenches on the links, fixed and floating bases, near the origin and far,
+// damping explicit (h = 0) and implicit over a step. The velocities of the
+// Jacobian-free kinematics are the Jacobians' J u.
+TEST(JointSpaceInertiaTest, ArticulatedBodyAlgorithmMatchesTheCompositeRigidBodySolve) {
+  std::mt19937 random(20261128);
+  std::uniform_real_distribution<double> effort(-3.0, 3.0);
+  int compared = 0;
+  for (const bool floating : {false, true}) {
+    for (const int links : {2, 3, 7, 16, 31}) {
+      for (const Vec3& where : {Vec3(0.0, 0.0, 1.0), Vec3(150.0, -80.0, 20.0)}) {
+        for (const double damping_step : {0.0, 1.0 / 240.0}) {
+          ArticulationModel model = RandomTree(links, floating, &random, /*mimics=*/false);
+          for (ArticulationLink& link : model.links) {
+            link.force = RandomVector(&random, 2.0);
+            link.torque = RandomVector(&random, 0.5);
+          }
+          const ArticulationState state = RandomState(model, where, &random);
+          Eigen::VectorXd efforts(model.joint_dofs);
+          for (Eigen::Index k = 0; k < efforts.size(); ++k) efforts[k] = effort(random);
+          const Vec3 gravity(0.3, -0.2, -9.81);
+          ArticulationKinematics kinematics;
+          ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
+          ASSERT_TRUE(ArticulatedBodyApplies(model));
+          ArticulatedBodyScratch scratch;
+          Eigen::VectorXd fast;
+          ArticulatedBodyForwardDynamics({model, state, kinematics, gravity, efforts, damping_step},
+                                         &scratch, &fast);
+          ArticulationKinematics with_jacobians;
+          Eigen::VectorXd reference;
+          CompositeRigidBodyForwardDynamics(
+              {model, state, kinematics, gravity, efforts, damping_step}, &with_jacobians,
+              &reference);
+          ASSERT_EQ(fast.size(), model.DofCount());
+          EXPECT_LT((fast - reference).cwiseAbs().maxCoeff(),
+                    1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
+              << links << " links, floating " << floating << ", at " << where.transpose() << ", h "
+              << damping_step;
+          for (std::size_t i = 0; i < model.links.size(); ++i) {
+            const double scale = 1.0 + state.u.cwiseAbs().maxCoeff() * 10.0;
+            EXPECT_LT(
+                (kinematics.linear_velocity[i] - with_jacobians.jacobian[i].topRows<3>() * state.u)
+                    .norm(),
+                1e-12 * scale);
+            EXPECT_LT((kinematics.angular_velocity[i] -
+                       with_jacobians.jacobian[i].bottomRows<3>() * state.u)
+                          .norm(),
+                      1e-12 * scale);
+          }
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 40);
 }
 
 // A single link turning about an axis through its hinge: M = I_axis + m d^2,
@@ -135,7 +196,7 @@ TEST(JointSpaceInertiaTest, OneHingeGivesTheParallelAxisTheorem) {
   state.q = Eigen::VectorXd::Constant(1, 0.3);
   state.u = Eigen::VectorXd::Zero(1);
   ArticulationKinematics kinematics;
-  ComputeKinematics(model, state, &kinematics);
+  ComputeKinematics(model, state, &kinematics, KinematicsParts::kWithJacobians);
   Eigen::MatrixXd mass;
   JointSpaceInertia(model, kinematics, &mass);
   EXPECT_NEAR(mass(0, 0), 0.04 + 2.0 * 0.5 * 0.5, 1e-15);

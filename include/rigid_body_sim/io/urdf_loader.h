@@ -24,11 +24,11 @@
 namespace rigid_body_sim::io {
 
 // Movable joints of one articulated model by default (~max_joints_per_model):
-// the dense dynamics cost about n^3 per evaluation, and a 64-joint chain's
-// worst step (a swinging heavy tip, the energy balance split 64 times) takes
-// 70 ms on the reference machine; 1000 joints would take seconds, holding
-// every other call of the node.
-inline constexpr int kDefaultMaxJointsPerModel = 64;
+// a step costs about n (the articulated-body algorithm), and a 250-joint
+// chain's worst step (a swinging heavy tip, the energy balance split 64
+// times) takes 37 ms on the reference machine (docs/limits.md), so no call
+// waits 100 ms behind one step.
+inline constexpr int kDefaultMaxJointsPerModel = 250;
 
 // Limits on collision geometry: every size of a box, cylinder, sphere or
 // mesh hull (m), and a shape's largest size over its smallest. Outside them

@@ -65,8 +65,8 @@ struct NodeOptions {
   // requests beyond them are refused (request_validation.h).
   RequestLimits limits;
   int max_links_per_model = 1000;  // ~max_links_per_model: count, >= 1
-  // ~max_joints_per_model: count, [1, 1000]: movable joints of one
-  // articulated model (io::kDefaultMaxJointsPerModel, 64).
+  // ~max_joints_per_model: count, [1, 999]: movable joints of one
+  // articulated model (io::kDefaultMaxJointsPerModel, 250).
   int max_joints_per_model = io::kDefaultMaxJointsPerModel;
   // The position servo of joint commands (physics/articulation.h):
   // ~joint_stiffness (N m/rad or N/m, 1e5, (0, 1e12]) and ~joint_damping
