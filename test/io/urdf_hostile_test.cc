@@ -127,10 +127,9 @@ TEST(UrdfHostileTest, MovableJointsBeyondTheLimitAreRefusedByName) {
   UrdfLoadOptions options;
   options.articulate = true;
   const int limit = kDefaultMaxJointsPerModel;
-  ExpectRefused(HingeChain(limit + 1),
-                {std::to_string(limit + 1) + " movable joints",
-                 "max_joints_per_model " + std::to_string(limit)},
-                options);
+  const std::string count = std::to_string(limit + 1) + " movable joints";
+  const std::string named = "max_joints_per_model " + std::to_string(limit);
+  ExpectRefused(HingeChain(limit + 1), {count.c_str(), named.c_str()}, options);
   const Result<LoadedModel> at_limit = LoadUrdfString(HingeChain(limit), options);
   ASSERT_TRUE(at_limit.ok()) << at_limit.message();
   EXPECT_EQ(at_limit->joints.size(), static_cast<std::size_t>(limit));
