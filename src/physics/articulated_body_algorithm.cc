@@ -30,12 +30,6 @@ namespace {
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
-Mat3 Skew(const Vec3& v) {
-  Mat3 m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
 // The spatial inertia about O of a body of mass m, centre c (relative to
 // O) and inertia I_c about its centre: [I_c - m [c]x[c]x, m [c]x;
 // -m [c]x, m 1] (Featherstone 2008, equation 2.63).
@@ -66,6 +60,11 @@ Vec6 CrossForce(const Vec6& m, const Vec6& f) {
 }
 
 }  // namespace
+
+bool AnyJointDamped(const ArticulationModel& model) {
+  return std::any_of(model.joints.begin(), model.joints.end(),
+                     [](const ArticulationJoint& joint) { return joint.def.damping > 0.0; });
+}
 
 bool ArticulatedBodyApplies(const ArticulationModel& model) {
   return std::all_of(model.joints.begin(), model.joints.end(),

@@ -11,12 +11,6 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-Mat3 Skew(const Vec3& v) {
-  Mat3 m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
 // The dof a joint's velocity comes from, and the factor: a mimic joint moves
 // with its leader's dof.
 int DrivingDof(const ArticulationModel& model, int joint, double* factor) {

@@ -19,6 +19,13 @@ namespace rigid_body_sim::physics {
 
 using JacobianRows = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // linear (3) then angular (3)
 
+// [v]x, the matrix of the cross product: Skew(v) w = v x w.
+inline Mat3 Skew(const Vec3& v) {
+  Mat3 m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
 struct ArticulationLink {
   std::uint32_t body = 0;                // the link's Body in the world
   int parent_joint = -1;                 // -1 for the base
@@ -73,6 +80,9 @@ struct ArticulationKinematics {
   std::vector<double> joint_velocity;
   std::vector<JacobianRows> jacobian;  // per link: (v_com, omega) = J u
 };
+
+// Whether any joint has damping (B != 0).
+bool AnyJointDamped(const ArticulationModel& model);
 
 // A joint's position and velocity from the state (mimic joints follow their
 // leader).

@@ -67,9 +67,7 @@ Eigen::VectorXd CommandedEfforts(const ArticulationModel& model) {
 bool DampingIsStiff(const ArticulationModel& model, const ArticulationKinematics& kinematics,
                     double dt) {
   constexpr double kMaxRate = 0.5;  // dt lambda
-  bool damped = false;
-  for (const ArticulationJoint& joint : model.joints) damped = damped || joint.def.damping > 0.0;
-  if (!damped) return false;
+  if (!AnyJointDamped(model)) return false;
   Eigen::MatrixXd mass;
   JointSpaceInertia(model, kinematics, &mass);
   const Eigen::MatrixXd inverse =
@@ -208,8 +206,7 @@ void WorldImpl::SolveArticulations(double dt) {
     if (joint_rows.empty() && !touched[i] && !DampingIsStiff(model, k, dt)) {
       // Without damping, u* came from the explicit dynamics: the first
       // RK4 stage's u'.
-      const bool damped = std::any_of(model.joints.begin(), model.joints.end(),
-                                      [](const ArticulationJoint& j) { return j.def.damping > 0; });
+      const bool damped = AnyJointDamped(model);
       entry.next = StepFreeMotionBalanced(
           {model, entry.state, settings_.gravity, efforts, dt, damped ? nullptr : &acceleration},
           &entry.free_motion_split);
