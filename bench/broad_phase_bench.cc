@@ -22,7 +22,7 @@
 #include <random>
 #include <vector>
 
-#include "physics/broad_phase.h"
+#include "physics/collision/broad_phase.h"
 
 namespace rigid_body_sim::physics {
 namespace {

@@ -16,7 +16,7 @@
 #include <ctime>
 #include <memory>
 
-#include "physics/narrow_phase.h"
+#include "physics/collision/narrow_phase.h"
 
 namespace rigid_body_sim::physics {
 namespace {

@@ -1,4 +1,4 @@
-#include "physics/broad_phase.h"
+#include "physics/collision/broad_phase.h"
 
 #include <cmath>
 #include <limits>
@@ -10,7 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "physics/aabb.h"
+#include "physics/geometry/aabb.h"
+#include "support/brute_force_broad_phase.h"
 
 namespace rigid_body_sim::physics {
 namespace {

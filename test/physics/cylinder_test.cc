@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "physics/gjk.h"
-#include "physics/narrow_phase.h"
+#include "support/gjk.h"
+#include "physics/collision/narrow_phase.h"
 #include "scene.h"
 
 namespace rigid_body_sim::physics {

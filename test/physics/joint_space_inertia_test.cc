@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "physics/articulation_dynamics.h"
+#include "physics/articulation/articulation_dynamics.h"
 
 namespace rigid_body_sim::physics {
 namespace {

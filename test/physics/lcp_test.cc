@@ -6,7 +6,7 @@
 
 #include <Eigen/Dense>
 
-#include "physics/lcp.h"
+#include "physics/solver/lcp.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::physics {

@@ -1,6 +1,6 @@
 // Narrow phase: box-box manifolds, sphere cases and half-spaces against
 // analytic contact points, the witness cache, and GJK distances.
-#include "physics/narrow_phase.h"
+#include "physics/collision/narrow_phase.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "physics/gjk.h"
-#include "physics/polyhedron_collision.h"
+#include "support/gjk.h"
+#include "physics/collision/polyhedron_collision.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
 
 namespace rigid_body_sim::physics {

@@ -1,7 +1,7 @@
 // PairIndex against std::unordered_map, the reference: the same random
 // inserts, erases and lookups must give the same answers, through growth
 // and long runs of backward-shift deletions.
-#include "physics/pair_index.h"
+#include "physics/collision/pair_index.h"
 
 #include <cstdint>
 #include <random>

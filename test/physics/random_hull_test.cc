@@ -16,9 +16,9 @@
 
 #include <gtest/gtest.h>
 
-#include "physics/gjk.h"
-#include "physics/narrow_phase.h"
-#include "physics/polyhedron_collision.h"
+#include "support/gjk.h"
+#include "physics/collision/narrow_phase.h"
+#include "physics/collision/polyhedron_collision.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
 
 namespace rigid_body_sim::physics {

@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "mesh_fixtures_static.h"
-#include "physics/sleep_window.h"
+#include "physics/dynamics/sleep_window.h"
 #include "rigid_body_sim/physics/mass_properties.h"
 #include "rigid_body_sim/physics/world.h"
 #include "scene.h"

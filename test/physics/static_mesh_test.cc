@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "mesh_fixtures_static.h"
-#include "physics/mesh_collision.h"
-#include "physics/mesh_orientation.h"
+#include "physics/collision/mesh_collision.h"
+#include "physics/geometry/mesh_orientation.h"
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/world.h"
 #include "scene.h"

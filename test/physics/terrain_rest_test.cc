@@ -11,7 +11,7 @@
 #include <memory>
 
 #include "mesh_fixtures_static.h"
-#include "physics/mesh_collision.h"
+#include "physics/collision/mesh_collision.h"
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/mass_properties.h"
 #include "rigid_body_sim/physics/world.h"

@@ -13,7 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "physics/task_pool.h"
+#include "physics/world/task_pool.h"
 #include "rigid_body_sim/physics/world.h"
 #include "scene.h"
 #include "state_hash.h"

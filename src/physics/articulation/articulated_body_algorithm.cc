@@ -1,0 +1,182 @@
+// Forward dynamics in O(n): the articulated-body algorithm (Featherstone
+// 2008, "Rigid Body Dynamics Algorithms", section 7.3, table 7.1), in
+// spatial vectors of one frame: world axes about a point O, here the base's
+// centre of mass (so that offsets stay small wherever the robot stands).
+// A motion is m = (omega, v_O), the velocity of the body's point at O; a
+// force is f = (n_O, f). In one fixed frame every transform is the identity:
+//   pass 1 (out):  v_i = v_p + S_i qdot_i,  c_i = v_i x S_i qdot_i,
+//                  p_i = v_i x* I_i v_i - f_ext,i;
+//   pass 2 (in):   U_i = I^A_i S_i,  D_i = S_i . U_i + a_i,
+//                  u_i = tau_i - S_i . p^A_i,
+//                  I^A_p += I^A_i - U_i U_i^T / D_i,
+//                  p^A_p += p^A_i + (I^A_i - U_i U_i^T / D_i) c_i + U_i u_i / D_i;
+//   pass 3 (out):  a'_i = a_p + c_i,  qddot_i = (u_i - U_i . a'_i) / D_i,
+//                  a_i = a'_i + S_i qddot_i,
+// with a_0 = 0 for a fixed base and a_0 = -(I^A_0)^-1 p^A_0 for a floating
+// one. A turning joint about unit s through p has S = (s, p x s) (relative
+// to O), a sliding one S = (0, s). The armature a_i = h B_i makes the
+// joints' damping implicit over a step h: the algorithm then solves
+// (M + h B) u' = Q exactly, as a joint's rotor inertia would enter.
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "physics/articulation/articulation_dynamics.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// The spatial inertia about O of a body of mass m, centre c (relative to
+// O) and inertia I_c about its centre: [I_c - m [c]x[c]x, m [c]x;
+// -m [c]x, m 1] (Featherstone 2008, equation 2.63).
+Mat6 SpatialInertia(double mass, const Vec3& c, const Mat3& inertia_com) {
+  const Mat3 cx = Skew(c);
+  Mat6 inertia;
+  inertia.topLeftCorner<3, 3>() = inertia_com - mass * cx * cx;
+  inertia.topRightCorner<3, 3>() = mass * cx;
+  inertia.bottomLeftCorner<3, 3>() = -mass * cx;
+  inertia.bottomRightCorner<3, 3>() = mass * Mat3::Identity();
+  return inertia;
+}
+
+// m1 x m2 = (w1 x w2, w1 x v2 + v1 x w2).
+Vec6 CrossMotion(const Vec6& m1, const Vec6& m2) {
+  Vec6 out;
+  out.head<3>() = m1.head<3>().cross(m2.head<3>());
+  out.tail<3>() = m1.head<3>().cross(m2.tail<3>()) + m1.tail<3>().cross(m2.head<3>());
+  return out;
+}
+
+// m x* f = (w x n + v x f, w x f).
+Vec6 CrossForce(const Vec6& m, const Vec6& f) {
+  Vec6 out;
+  out.head<3>() = m.head<3>().cross(f.head<3>()) + m.tail<3>().cross(f.tail<3>());
+  out.tail<3>() = m.head<3>().cross(f.tail<3>());
+  return out;
+}
+
+}  // namespace
+
+bool AnyJointDamped(const ArticulationModel& model) {
+  return std::any_of(model.joints.begin(), model.joints.end(),
+                     [](const ArticulationJoint& joint) { return joint.def.damping > 0.0; });
+}
+
+bool ArticulatedBodyApplies(const ArticulationModel& model) {
+  return std::all_of(model.joints.begin(), model.joints.end(),
+                     [](const ArticulationJoint& joint) { return joint.dof >= 0; });
+}
+
+// Pass 1 and the bodies' own terms: spatial inertia, velocity, velocity
+// product and bias force per link, all about O.
+void ArticulatedBodyScratch::Prepare(const ForwardDynamicsInput& in) {
+  const ArticulationModel& model = in.model;
+  const ArticulationKinematics& k = in.kinematics;
+  const std::size_t link_count = model.links.size();
+  origin = in.state.base_com;
+  inertia.resize(link_count);
+  bias.resize(link_count);
+  velocity.resize(link_count);
+  product.resize(link_count);
+  acceleration.resize(link_count);
+  subspace.resize(model.joints.size());
+  inertia_subspace.resize(model.joints.size());
+  pivot.resize(model.joints.size());
+  remainder.resize(model.joints.size());
+  for (std::size_t i = 0; i < link_count; ++i) {
+    const ArticulationLink& link = model.links[i];
+    const Vec3 c = k.com_world[i] - origin;
+    inertia[i] = SpatialInertia(link.mass, c, k.inertia_world[i]);
+    velocity[i].head<3>() = k.angular_velocity[i];
+    velocity[i].tail<3>() = k.linear_velocity[i] - k.angular_velocity[i].cross(c);
+    product[i].setZero();
+    const Vec3 force = link.mass * in.gravity + link.force;
+    Vec6 external;
+    external.head<3>() = link.torque + c.cross(force);
+    external.tail<3>() = force;
+    bias[i] = CrossForce(velocity[i], inertia[i] * velocity[i]) - external;
+  }
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    const JointDef& def = model.joints[j].def;
+    Vec6& s = subspace[j];
+    if (def.type == JointType::kPrismatic) {
+      s << Vec3::Zero(), k.joint_axis_world[j];
+    } else {
+      s << k.joint_axis_world[j], (k.joint_anchor_world[j] - origin).cross(k.joint_axis_world[j]);
+    }
+    product[def.child_link] = CrossMotion(velocity[def.child_link], s * k.joint_velocity[j]);
+  }
+}
+
+void ArticulatedBodyForwardDynamics(const ForwardDynamicsInput& in, ArticulatedBodyScratch* scratch,
+                                    Eigen::VectorXd* acceleration) {
+  const ArticulationModel& model = in.model;
+  ArticulatedBodyScratch& s = *scratch;
+  s.Prepare(in);
+  // Pass 2, from the leaves in: a joint comes after its parent link's joint.
+  for (std::size_t j = model.joints.size(); j-- > 0;) {
+    const ArticulationJoint& joint = model.joints[j];
+    const int child = joint.def.child_link;
+    const int parent = joint.def.parent_link;
+    const int column = model.base_dofs + joint.dof;
+    const double tau = in.joint_efforts[joint.dof] - joint.def.damping * in.state.u[column];
+    s.inertia_subspace[j] = s.inertia[child] * s.subspace[j];
+    s.pivot[j] = s.subspace[j].dot(s.inertia_subspace[j]) + in.damping_step * joint.def.damping;
+    s.remainder[j] = tau - s.subspace[j].dot(s.bias[child]);
+    const Mat6 articulated =
+        s.inertia[child] - s.inertia_subspace[j] * s.inertia_subspace[j].transpose() / s.pivot[j];
+    s.inertia[parent] += articulated;
+    s.bias[parent] += s.bias[child] + articulated * s.product[child] +
+                      s.inertia_subspace[j] * (s.remainder[j] / s.pivot[j]);
+  }
+  acceleration->resize(model.DofCount());
+  if (model.base_dofs == 6) {
+    s.acceleration[0] = -s.inertia[0].llt().solve(s.bias[0]);
+    // The base's u is (v_com, omega), and O is its centre of mass: the
+    // centre's acceleration is a_O + omega x v_com (a body point at O).
+    const Vec3 omega = in.kinematics.angular_velocity[0];
+    acceleration->head<3>() =
+        s.acceleration[0].tail<3>() + omega.cross(in.kinematics.linear_velocity[0]);
+    acceleration->segment<3>(3) = s.acceleration[0].head<3>();
+  } else {
+    s.acceleration[0].setZero();
+  }
+  // Pass 3, from the base out.
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    const ArticulationJoint& joint = model.joints[j];
+    const int child = joint.def.child_link;
+    const Vec6 reached = s.acceleration[joint.def.parent_link] + s.product[child];
+    const double qddot = (s.remainder[j] - s.inertia_subspace[j].dot(reached)) / s.pivot[j];
+    s.acceleration[child] = reached + s.subspace[j] * qddot;
+    (*acceleration)[model.base_dofs + joint.dof] = qddot;
+  }
+}
+
+void CompositeRigidBodyForwardDynamics(const ForwardDynamicsInput& in,
+                                       ArticulationKinematics* kinematics,
+                                       Eigen::VectorXd* acceleration) {
+  ComputeKinematics(in.model, in.state, kinematics, KinematicsParts::kWithJacobians);
+  JointSpaceDynamics dynamics;
+  ComputeDynamics(in.model, in.state, *kinematics, in.gravity, in.joint_efforts, &dynamics);
+  for (const ArticulationJoint& joint : in.model.joints) {
+    if (joint.dof < 0) continue;
+    const int column = in.model.base_dofs + joint.dof;
+    dynamics.mass(column, column) += in.damping_step * joint.def.damping;
+  }
+  *acceleration = dynamics.mass.llt().solve(dynamics.force);
+}
+
+void ForwardDynamics(const ForwardDynamicsInput& in, ArticulatedBodyScratch* scratch,
+                     Eigen::VectorXd* acceleration) {
+  if (ArticulatedBodyApplies(in.model)) {
+    ArticulatedBodyForwardDynamics(in, scratch, acceleration);
+  } else {
+    CompositeRigidBodyForwardDynamics(in, &scratch->kinematics, acceleration);
+  }
+}
+
+}  // namespace rigid_body_sim::physics

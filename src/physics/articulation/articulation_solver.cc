@@ -1,0 +1,206 @@
+#include "physics/articulation/articulation_solver.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace rigid_body_sim::physics {
+
+void ArticulationSolver::Reset() {
+  articulations_.clear();
+  bodies_.clear();
+  slot_of_body_.clear();
+  rows_.clear();
+}
+
+int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u, const Eigen::MatrixXd& mass) {
+  ArticulationSlot& slot = articulations_.emplace_back();
+  slot.u = u;
+  slot.mass.compute(mass);
+  return static_cast<int>(articulations_.size()) - 1;
+}
+
+int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u,
+                                        const Eigen::LLT<Eigen::MatrixXd>& mass) {
+  articulations_.push_back(ArticulationSlot{u, mass});
+  return static_cast<int>(articulations_.size()) - 1;
+}
+
+int ArticulationSolver::BodySlotOf(const BodySlot& body) {
+  if (slot_of_body_.size() <= body.body) slot_of_body_.resize(body.body + 1, -1);
+  int& slot = slot_of_body_[body.body];
+  if (slot < 0) {
+    slot = static_cast<int>(bodies_.size());
+    bodies_.push_back(body);
+  }
+  return slot;
+}
+
+RowSide ArticulationSolver::ArticulationSide(int slot, const Eigen::VectorXd& jacobian) const {
+  RowSide side;
+  side.kind = RowSide::Kind::kArticulation;
+  side.slot = slot;
+  side.jacobian = jacobian;
+  side.response = articulations_[slot].mass.solve(jacobian);
+  return side;
+}
+
+RowSide ArticulationSolver::BodySide(int slot, const Vec3& direction, const Vec3& lever_arm) const {
+  RowSide side;
+  const BodySlot& body = bodies_[slot];
+  if (body.inverse_mass == 0.0) return side;  // static or asleep: the row sees no velocity
+  side.kind = RowSide::Kind::kBody;
+  side.slot = slot;
+  side.linear = direction;
+  side.angular = lever_arm.cross(direction);
+  side.linear_response = body.inverse_mass * direction;
+  side.angular_response = body.inverse_inertia_world * side.angular;
+  return side;
+}
+
+int ArticulationSolver::AddRow(ConstraintRow row) {
+  rows_.push_back(std::move(row));
+  return static_cast<int>(rows_.size()) - 1;
+}
+
+double ArticulationSolver::SideVelocity(const RowSide& side) const {
+  switch (side.kind) {
+    case RowSide::Kind::kArticulation:
+      return side.jacobian.dot(articulations_[side.slot].u);
+    case RowSide::Kind::kBody: {
+      const BodySlot& body = bodies_[side.slot];
+      return side.linear.dot(body.linear_velocity) + side.angular.dot(body.angular_velocity);
+    }
+    case RowSide::Kind::kNone:
+      break;
+  }
+  return 0.0;
+}
+
+double ArticulationSolver::SideResponse(const RowSide& side) const {
+  switch (side.kind) {
+    case RowSide::Kind::kArticulation:
+      return side.jacobian.dot(side.response);
+    case RowSide::Kind::kBody:
+      return side.linear.dot(side.linear_response) + side.angular.dot(side.angular_response);
+    case RowSide::Kind::kNone:
+      break;
+  }
+  return 0.0;
+}
+
+double ArticulationSolver::RowVelocity(const ConstraintRow& row) const {
+  return SideVelocity(row.a) + SideVelocity(row.b);
+}
+
+void ArticulationSolver::ApplyImpulse(const ConstraintRow& row, double impulse) {
+  for (const RowSide* side : {&row.a, &row.b}) {
+    if (side->kind == RowSide::Kind::kArticulation) {
+      articulations_[side->slot].u += impulse * side->response;
+    } else if (side->kind == RowSide::Kind::kBody) {
+      BodySlot& body = bodies_[side->slot];
+      // As in ContactSolver::ApplyImpulse: a body that does not move keeps
+      // its zero velocity even when the impulse overflowed.
+      if (body.inverse_mass == 0.0) continue;
+      body.linear_velocity += impulse * side->linear_response;
+      body.angular_velocity += impulse * side->angular_response;
+    }
+  }
+}
+
+// The two friction rows of a point together: each moves toward zero
+// tangential velocity, then the pair is projected onto the disc
+// |lambda_t| <= mu lambda_n (a circular Coulomb cone). Returns the largest
+// change.
+double ArticulationSolver::UpdateFriction(std::size_t k) {
+  ConstraintRow& t0 = rows_[k];
+  ConstraintRow& t1 = rows_[k + 1];
+  const double limit = t0.friction * rows_[t0.normal_row].impulse;
+  double l0 = t0.impulse - t0.inverse_mass * RowVelocity(t0);
+  double l1 = t1.impulse - t1.inverse_mass * RowVelocity(t1);
+  const double norm = std::hypot(l0, l1);
+  if (norm > limit) {
+    const double scale = norm > 0.0 ? limit / norm : 0.0;
+    l0 *= scale;
+    l1 *= scale;
+  }
+  const double change0 = l0 - t0.impulse;
+  const double change1 = l1 - t1.impulse;
+  t0.impulse = l0;
+  t1.impulse = l1;
+  ApplyImpulse(t0, change0);
+  ApplyImpulse(t1, change1);
+  return std::max(std::abs(change0), std::abs(change1));
+}
+
+// Projected Gauss-Seidel on the rows (Cottle, Pang and Stone 1992, "The
+// Linear Complementarity Problem", section 5.2; with friction, the
+// per-point cone projection of Erleben 2007, section 3): per row,
+// lambda <- proj(lambda - (v - target + gamma lambda) / (J M^-1 J^T + gamma)),
+// the projection being onto [lower, upper], onto lambda >= 0 for a normal,
+// and onto the friction disc for a tangent pair. The warm start's impulses
+// are applied first.
+int ArticulationSolver::Solve(int max_sweeps, double tolerance) {
+  for (ConstraintRow& row : rows_) {
+    const double response = SideResponse(row.a) + SideResponse(row.b) + row.softness;
+    row.inverse_mass = response > 0.0 ? 1.0 / response : 0.0;
+    if (row.kind == RowKind::kBounded) row.impulse = std::clamp(row.impulse, row.lower, row.upper);
+    if (row.kind == RowKind::kNormal) row.impulse = std::max(row.impulse, 0.0);
+    if (row.impulse != 0.0) ApplyImpulse(row, row.impulse);
+  }
+  int sweep = 0;
+  while (sweep < max_sweeps) {
+    ++sweep;
+    double largest = 0.0;
+    double scale = 0.0;
+    for (std::size_t k = 0; k < rows_.size(); ++k) {
+      ConstraintRow& row = rows_[k];
+      // A tangent row is always taken with its pair, even one that moves
+      // nothing (a cart on a rail across it): skipping it alone would take
+      // its pair for the first of a pair, and the row after for its pair.
+      if (row.kind == RowKind::kTangent) {
+        largest = std::max(largest, UpdateFriction(k));
+        ++k;  // its pair was updated with it
+        continue;
+      }
+      largest = std::max(largest, UpdateRow(&row));
+      scale = std::max(scale, std::abs(row.impulse));
+    }
+    if (largest <= tolerance * std::max(scale, 1e-12)) break;
+  }
+  return sweep;
+}
+
+// lambda <- proj(lambda - (v - target + gamma lambda) / (J M^-1 J^T + gamma)),
+// onto lambda >= 0 for a normal, [lower, upper] for a bounded row.
+double ArticulationSolver::UpdateRow(ConstraintRow* row) {
+  if (row->inverse_mass == 0.0) return 0.0;
+  const double velocity = RowVelocity(*row);
+  double next =
+      row->impulse - row->inverse_mass * (velocity - row->target + row->softness * row->impulse);
+  next = row->kind == RowKind::kNormal ? std::max(next, 0.0)
+                                       : std::clamp(next, row->lower, row->upper);
+  const double change = next - row->impulse;
+  row->impulse = next;
+  if (change != 0.0) ApplyImpulse(*row, change);
+  return std::abs(change);
+}
+
+int ArticulationSolver::SweepRows(const std::vector<std::size_t>& rows, int max_sweeps,
+                                  double tolerance) {
+  int sweep = 0;
+  while (sweep < max_sweeps) {
+    ++sweep;
+    double largest = 0.0;
+    double scale = 0.0;
+    for (const std::size_t k : rows) {
+      assert(rows_[k].kind != RowKind::kTangent);
+      largest = std::max(largest, UpdateRow(&rows_[k]));
+      scale = std::max(scale, std::abs(rows_[k].impulse));
+    }
+    if (largest <= tolerance * std::max(scale, 1e-12)) break;
+  }
+  return sweep;
+}
+
+}  // namespace rigid_body_sim::physics

@@ -1,0 +1,131 @@
+// The constraint solve of the articulations: contact points on their links,
+// joint limits, servos, motors and joint friction, as rows of one
+// complementarity problem in the joint-space velocities, solved by projected
+// Gauss-Seidel (docs/design.md, "Articulated bodies").
+//
+// A row k has a Jacobian J_k over the velocities of the articulations and
+// rigid bodies it touches, and an impulse lambda_k. Its velocity is
+// v_k = J_k u. The effect of an impulse is u += M^-1 J_k^T lambda_k, made
+// once per row and step (for an articulation, the dense solve with the
+// joint-space inertia; for a rigid body, d/m and I^-1 (r x d)), so a sweep
+// costs O(dofs) per row. This is the generalized form of the contact
+// problem of Baraff 1996, "Linear-Time Dynamics using Lagrange Multipliers",
+// section 7 (contact and joint limits as unilateral rows), solved with the
+// Delassus operator J M^-1 J^T applied implicitly (Erleben 2007,
+// "Velocity-based shock propagation for multibody dynamics animation",
+// section 3, projected Gauss-Seidel over generalized velocities).
+#ifndef RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SOLVER_H_
+#define RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SOLVER_H_
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+// One side of a row: an articulation's dense Jacobian row, or a rigid body's
+// direction at a lever arm, or nothing (a static or sleeping body).
+struct RowSide {
+  enum class Kind : std::uint8_t { kNone, kArticulation, kBody };
+  Kind kind = Kind::kNone;
+  int slot = -1;                         // index of the articulation or body slot
+  Eigen::VectorXd jacobian;              // articulation: J_k over its u
+  Eigen::VectorXd response;              // articulation: M^-1 J_k^T
+  Vec3 linear = Vec3::Zero();            // body: d
+  Vec3 angular = Vec3::Zero();           // body: r x d
+  Vec3 linear_response = Vec3::Zero();   // body: d / m
+  Vec3 angular_response = Vec3::Zero();  // body: I^-1 (r x d)
+};
+
+enum class RowKind : std::uint8_t {
+  kBounded,  // lower <= lambda <= upper; v -> target (soft when softness > 0)
+  kNormal,   // lambda >= 0, v >= target, lambda (v - target) = 0
+  kTangent,  // friction, with the next row its pair: |(l_t0, l_t1)| <= mu l_normal
+};
+
+struct ConstraintRow {
+  RowSide a;
+  RowSide b;
+  RowKind kind = RowKind::kBounded;
+  double target = 0.0;                                      // velocity units of the row
+  double lower = -std::numeric_limits<double>::infinity();  // impulse
+  double upper = std::numeric_limits<double>::infinity();
+  // gamma of a soft constraint: v + gamma lambda -> target (Catto 2011,
+  // "Soft Constraints", GDC; the constraint force mixing of ODE).
+  double softness = 0.0;
+  int normal_row = -1;     // kTangent: its normal row
+  double friction = 0.0;   // kTangent: mu
+  double impulse = 0.0;    // lambda, warm start in, result out
+  bool colliding = false;  // a contact point classified colliding
+  // kNormal of a contact point still apart that closes within the step
+  // faster than the collision threshold: -e v-, the v+ it leaves with once
+  // its row has stopped it (impulse > 0). 0: no bounce.
+  double bounce = 0.0;
+  // A joint's own row (limit, servo, motor, friction): whose, and the sign
+  // its impulse has as the joint's effort.
+  int articulation = -1;
+  int joint = -1;
+  double joint_sign = 1.0;
+  double inverse_mass = 0.0;  // 1 / (J M^-1 J^T + gamma), set by Solve
+};
+
+class ArticulationSolver {
+ public:
+  struct BodySlot {
+    std::uint32_t body = 0;
+    Vec3 linear_velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    double inverse_mass = 0.0;
+    Mat3 inverse_inertia_world = Mat3::Zero();
+  };
+  struct ArticulationSlot {
+    Eigen::VectorXd u;
+    Eigen::LLT<Eigen::MatrixXd> mass;  // factor of the joint-space inertia
+  };
+
+  void Reset();
+  int AddArticulation(const Eigen::VectorXd& u, const Eigen::MatrixXd& mass);
+  // As above, with the joint-space inertia already factored.
+  int AddArticulation(const Eigen::VectorXd& u, const Eigen::LLT<Eigen::MatrixXd>& mass);
+  // The slot of a rigid body, added once.
+  int BodySlotOf(const BodySlot& body);
+  RowSide ArticulationSide(int slot, const Eigen::VectorXd& jacobian) const;
+  RowSide BodySide(int slot, const Vec3& direction, const Vec3& lever_arm) const;
+  int AddRow(ConstraintRow row);
+
+  // Projected Gauss-Seidel until no impulse changes by more than
+  // `tolerance` (relative to its size) or `max_sweeps`. Returns the sweeps.
+  int Solve(int max_sweeps, double tolerance);
+  // Further sweeps over the given rows only (none a tangent), the other
+  // rows' impulses held; returns the sweeps.
+  int SweepRows(const std::vector<std::size_t>& rows, int max_sweeps, double tolerance);
+  // v_k = J_k u with the current velocities.
+  double RowVelocity(const ConstraintRow& row) const;
+
+  std::vector<ConstraintRow>& rows() { return rows_; }
+  std::vector<ArticulationSlot>& articulations() { return articulations_; }
+  std::vector<BodySlot>& bodies() { return bodies_; }
+
+ private:
+  double SideVelocity(const RowSide& side) const;
+  double SideResponse(const RowSide& side) const;  // J M^-1 J^T of the side
+  void ApplyImpulse(const ConstraintRow& row, double impulse);
+  // One projected Gauss-Seidel update of a normal or bounded row; returns
+  // |change of its impulse|.
+  double UpdateRow(ConstraintRow* row);
+  double UpdateFriction(std::size_t k);
+
+  std::vector<ArticulationSlot> articulations_;
+  std::vector<BodySlot> bodies_;
+  std::vector<int> slot_of_body_;
+  std::vector<ConstraintRow> rows_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SOLVER_H_

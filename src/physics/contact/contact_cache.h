@@ -1,0 +1,166 @@
+// Stage 3 of a step: contacts carried from one step to the next.
+//
+// Per pair of shapes the broad phase reports, the cache keeps the separating
+// witness (Baraff's cached defining face or edge: Baraff 1997,
+// "Rigid Body Simulation II", section 7.1) and the
+// impulses of last step's contact points, so the narrow phase tests the
+// witness first and the solver starts from last step's impulses.
+#ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_CACHE_H_
+#define RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_CACHE_H_
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "physics/contact/contact_manifold.h"
+#include "physics/collision/pair_index.h"
+
+namespace rigid_body_sim::physics {
+
+struct CachedImpulse {
+  FeatureId feature;
+  double normal_impulse = 0.0;              // N s
+  std::array<double, 2> tangent_impulse{};  // N s, in the manifold's tangent basis
+  Vec3 position_world = Vec3::Zero();       // m, where the point was; set in `previous`
+};
+
+// What a manifold between two polyhedra needs to be carried to a nearby
+// relative pose without clipping again: each point's two surface points as
+// material points of the shapes, and the reference face's normal in its own
+// shape's frame.
+struct ManifoldAnchors {
+  bool valid = false;
+  Pose b_from_a;  // principal frames of the bodies, when computed
+  bool normal_turns_with_a = true;
+  Vec3 normal_shape = Vec3::UnitZ();                     // unit, reference shape frame
+  std::array<Vec3, ContactManifold::kMaxPoints> on_a{};  // m, A's shape frame
+  std::array<Vec3, ContactManifold::kMaxPoints> on_b{};  // m, B's shape frame
+};
+
+struct ShapePairContact {
+  // The fields every visit reads first, together in one cache line.
+  std::uint64_t key = 0;     // ContactCache's key of the four indices below
+  std::uint32_t body_a = 0;  // body slot indices
+  std::uint32_t body_b = 0;
+  std::uint16_t shape_a = 0;
+  std::uint16_t shape_b = 0;
+  std::uint64_t last_seen_step = 0;
+  // m; the narrow phase reported points closer than this, so with none the
+  // shapes are at least this far apart.
+  double contact_distance = 0.0;
+  // With no points: a lower bound on the shapes' distance when the pair was
+  // last tested (m, -infinity when not known), and the summed travel of the
+  // two bodies then (Body::travel).
+  double apart_gap = -std::numeric_limits<double>::infinity();
+  double apart_travel = 0.0;
+  SeparatingWitness witness;
+  ContactManifold manifold;  // this step's
+  ManifoldAnchors anchors;
+  // m; how far the reused manifold's points may be from where clipping would
+  // put them (0 when the manifold was clipped this step).
+  double reuse_error = 0.0;
+  // Warm start for this step's points, matched by feature id.
+  std::array<CachedImpulse, ContactManifold::kMaxPoints> warm_start{};
+  // Last step's points and their final impulses.
+  std::array<CachedImpulse, ContactManifold::kMaxPoints> previous{};
+  int previous_count = 0;
+};
+
+// Entries ahead of the one in use whose lines a walk over entries starts
+// loading (PrefetchManifold, PrefetchPoints): the entries, about 1 kB each,
+// are scattered over more memory than the caches hold.
+constexpr std::size_t kEntryPrefetchDistance = 4;
+
+inline void PrefetchBytes(const void* begin, std::size_t size) {
+  const char* bytes = static_cast<const char*>(begin);
+  for (std::size_t offset = 0; offset < size; offset += 64) __builtin_prefetch(bytes + offset);
+}
+
+// Starts loading the visit fields and the manifold of an entry.
+inline void PrefetchManifold(const ShapePairContact& entry) {
+  PrefetchBytes(&entry, offsetof(ShapePairContact, manifold) + sizeof(entry.manifold));
+}
+
+// Starts loading what the stages after the narrow phase read and write of
+// an entry: the manifold, the warm start and last step's points.
+inline void PrefetchPoints(const ShapePairContact& entry) {
+  PrefetchBytes(&entry.manifold, sizeof(entry.manifold));
+  PrefetchBytes(&entry.warm_start, sizeof(entry.warm_start) + sizeof(entry.previous));
+}
+
+// For a walk over `entries` now at `index`: `prefetch` (PrefetchManifold or
+// PrefetchPoints) of the entry kEntryPrefetchDistance ahead, if there is one.
+inline void PrefetchAhead(const std::vector<ShapePairContact*>& entries, std::size_t index,
+                          void (*prefetch)(const ShapePairContact&)) {
+  if (index + kEntryPrefetchDistance < entries.size()) {
+    prefetch(*entries[index + kEntryPrefetchDistance]);
+  }
+}
+
+class ContactCache {
+ public:
+  // Starts loading what a Touch of the pair will read, some visits before
+  // it: kSlot its index slot, kEntry (once the slot is loaded) the entry
+  // itself. Changes nothing.
+  enum class Prefetch { kSlot, kEntry };
+  void PrefetchPair(Prefetch stage, std::uint32_t body_a, std::uint16_t shape_a,
+                    std::uint32_t body_b, std::uint16_t shape_b) const;
+
+  // The entry of a shape pair, created empty when new; marks it seen.
+  ShapePairContact& Touch(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
+                          std::uint16_t shape_b, std::uint64_t step);
+  // Drops the pairs not seen in `step` unless `asleep` says both of their
+  // bodies sleep (their contacts still hold, frozen), matches every touching
+  // manifold's points with last step's by feature id, or else by position,
+  // and lists the pairs.
+  // Frozen pairs are set aside and cost nothing per step; pass
+  // `recheck_frozen` when a body woke or left since the last call, so that
+  // frozen pairs of bodies no longer asleep go.
+  void MatchAndPrune(std::uint64_t step, bool recheck_frozen,
+                     const std::function<bool(const ShapePairContact&)>& asleep);
+  // Pairs with at least one contact point this step, in key order.
+  const std::vector<ShapePairContact*>& touching() const { return touching_; }
+  // Every pair the narrow phase looked at this step, touching or not, in
+  // the order it looked at them.
+  const std::vector<ShapePairContact*>& seen() const { return seen_; }
+  // Pairs of sleeping bodies, with the contacts and impulses they fell asleep with.
+  const std::vector<const ShapePairContact*>& sleeping() const { return sleeping_; }
+  // Changes whenever sleeping() does.
+  std::uint64_t sleeping_version() const { return sleeping_version_; }
+  // Forgets the pairs of one body (when it is destroyed or teleported).
+  void RemoveBody(std::uint32_t body);
+  void Clear();
+  std::size_t size() const { return pairs_.size() + frozen_.size(); }
+
+ private:
+  using PairMap = std::unordered_map<std::uint64_t, ShapePairContact>;
+  static std::uint64_t Key(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
+                           std::uint16_t shape_b);
+  static bool KeyLess(const ShapePairContact* x, const ShapePairContact* y);
+  // Lists the frozen pairs in sleeping_ and bumps its version.
+  void ListSleeping();
+
+  PairMap pairs_;                      // pairs the narrow phase looks at
+  PairIndex<ShapePairContact> index_;  // key -> entry of pairs_, for Touch
+  PairMap frozen_;                     // pairs of two sleeping (or static) bodies
+  std::vector<ShapePairContact*> touching_;
+  std::vector<ShapePairContact*> seen_;     // after MatchAndPrune, every entry of pairs_
+  std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
+  std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of MatchAndPrune
+  std::vector<const ShapePairContact*> sleeping_;
+  std::uint64_t sleeping_version_ = 0;
+  bool frozen_changed_ = false;  // frozen_ differs from sleeping_
+};
+
+// Each point of `entry`'s manifold takes last step's impulses of the point
+// with the same features, else of the nearest unmatched one (warm start).
+void MatchWarmStarts(ShapePairContact* entry);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_CACHE_H_

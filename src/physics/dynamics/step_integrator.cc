@@ -1,0 +1,480 @@
+// Stage 5 of WorldImpl::Step: drift the bodies, back up the ones that would
+// enter another body to their time of impact, and put quiet islands to sleep.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <variant>
+
+#include "physics/dynamics/integrator.h"
+#include "physics/collision/narrow_phase.h"
+#include "physics/geometry/shape_bounds.h"
+#include "physics/world/union_find.h"
+#include "physics/world/world_impl.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// Bisection stops when the bracket is shorter than this fraction of the step.
+constexpr double kTimeOfImpactTolerance = 1e-6;
+
+// Samples along a fast body's path, at most: 2 km/s against a 1 mm thick
+// plate at 240 Hz.
+constexpr double kMaxPathSamples = 1e4;
+
+// One pair's shapes carried along their bodies' paths over the step.
+struct PairSweep {
+  const BodyPath* path_a = nullptr;
+  const Body* a = nullptr;
+  const BodyPath* path_b = nullptr;
+  const Body* b = nullptr;
+  int shape_a = 0;
+  int shape_b = 0;
+  double gap_cap = 0.0;  // m, beyond anything the step can reach
+  // m, the radii of spheres about the two shapes' origins that hold them;
+  // infinite for a half-space.
+  double radius_a = 0.0;
+  double radius_b = 0.0;
+
+  static Pose WorldFromBodyAt(const BodyPath& path, const Body& body, double t) {
+    const Pose world_from_principal = path.dt > 0.0 ? path.At(t) : body.WorldFromPrincipal();
+    return world_from_principal * body.principal_from_body;
+  }
+  CollideInput InputAt(double t, double contact_distance) const {
+    const ShapeDef& shape_def_a = a->shapes[shape_a];
+    const ShapeDef& shape_def_b = b->shapes[shape_b];
+    CollideInput input;
+    input.a = &shape_def_a.geometry;
+    input.world_from_a = WorldFromBodyAt(*path_a, *a, t) * shape_def_a.body_from_shape;
+    input.b = &shape_def_b.geometry;
+    input.world_from_b = WorldFromBodyAt(*path_b, *b, t) * shape_def_b.body_from_shape;
+    input.contact_distance = contact_distance;
+    return input;
+  }
+  // A lower bound on the gap at time t, from the two shapes' bounding
+  // spheres: a test of a few flops that lets the search skip the samples of
+  // a fast body's path far from the other body, where a full test (a
+  // cylinder against a hull of many edges) would cost thousands of times
+  // more.
+  double SphereGapAt(double t) const {
+    const Vec3 a_world =
+        WorldFromBodyAt(*path_a, *a, t) * a->shapes[shape_a].body_from_shape.translation;
+    const Vec3 b_world =
+        WorldFromBodyAt(*path_b, *b, t) * b->shapes[shape_b].body_from_shape.translation;
+    return (a_world - b_world).norm() - radius_a - radius_b;
+  }
+  // The gap at time t: the nearest manifold point, at most gap_cap.
+  double GapAt(double t) const {
+    ContactManifold manifold;
+    double gap = gap_cap;
+    if (Collide(InputAt(t, gap_cap), nullptr, &manifold)) {
+      for (int i = 0; i < manifold.point_count; ++i) {
+        gap = std::min(gap, manifold.points[i].separation);
+      }
+    }
+    return gap;
+  }
+};
+
+// m; the radius of a sphere about the shape's origin that holds it.
+double ShapeRadius(const ShapeGeometry& geometry) {
+  if (std::holds_alternative<HalfSpace>(geometry)) return std::numeric_limits<double>::infinity();
+  return ShapeBoundingRadius(geometry, Vec3::Zero());
+}
+
+// Times with gap(low) > target_gap >= gap(high).
+struct ImpactBracket {
+  double low = 0.0;       // s
+  double gap_low = 0.0;   // m
+  double high = -1.0;     // s; < 0 while no sample touched
+  double gap_high = 0.0;  // m
+};
+
+// Regula falsi on gap(t) = aim, keeping the bracket gap(low) > target_gap >=
+// gap(high) (Illinois: the end kept twice in a row has its value halved, so
+// it converges superlinearly instead of creeping; Dowell and Jarratt, "A
+// modified regula falsi method for computing the root of an equation",
+// BIT 11, 1971). It ends when `low` is within a tenth of the touching band
+// above target_gap, so the free flight is cut short by at most that much,
+// or when the bracket is within tolerance, as plain bisection would.
+// Returns the narrowed bracket, whose legal end is `low`.
+ImpactBracket NarrowImpactBracket(const PairSweep& sweep, double target_gap, double touching,
+                                  double dt, ImpactBracket bracket) {
+  const double close_enough = target_gap + 0.1 * (touching - target_gap);
+  const double aim = target_gap + 0.05 * (touching - target_gap);
+  int kept_side = 0;  // -1: low was kept last time, +1: high
+  double weight_low = 1.0;
+  double weight_high = 1.0;
+  while (bracket.gap_low > close_enough &&
+         bracket.high - bracket.low > kTimeOfImpactTolerance * dt) {
+    const double f_low = weight_low * (bracket.gap_low - aim);
+    const double f_high = weight_high * (bracket.gap_high - aim);
+    double t = bracket.low + (bracket.high - bracket.low) * f_low / (f_low - f_high);
+    if (!(t > bracket.low && t < bracket.high)) t = 0.5 * (bracket.low + bracket.high);
+    const double gap = sweep.GapAt(t);
+    if (gap > target_gap) {
+      bracket.low = t;
+      bracket.gap_low = gap;
+      weight_low = 1.0;
+      weight_high = kept_side == 1 ? 0.5 * weight_high : 1.0;
+      kept_side = 1;
+    } else {
+      bracket.high = t;
+      bracket.gap_high = gap;
+      weight_high = 1.0;
+      weight_low = kept_side == -1 ? 0.5 * weight_low : 1.0;
+      kept_side = -1;
+    }
+  }
+  return bracket;
+}
+
+}  // namespace
+
+// Time of impact by bracketing (Baraff 1997, "Rigid Body
+// Simulation II", section 6, backing up to the collision time t_c): with Y(t0) legal and Y(t0 + dt)
+// penetrating, test a time inside the bracket and keep the part whose ends
+// differ, until the legal end touches or the bracket is within tolerance.
+// The test time is the regula falsi estimate from the two ends' gaps, with
+// the midpoint (bisection) as its fallback. A body faster than a fraction
+// of its thickness per step is first sampled along its path, so that a thin
+// wall it would pass through entirely still shows a penetrating sample to
+// bracket. Pairs that cannot close their gap within the step are skipped.
+void WorldImpl::IntegrateBodies(double dt) {
+  MoveArticulations(dt);
+  DriftBodies(dt);
+  BoundBodyMotion(dt);
+  ResolveImpacts(dt, FindImpacts(dt, contact_cache_.seen()), contact_cache_.touching(), 0);
+  UpdateSleep(dt);
+}
+
+// Scales a moving body's angular momenta (at the start and the end of the
+// step) so that its angular velocity turns it at most max_turn_per_step in
+// dt: |w| <= max_turn / dt with w = I^-1 L. The scale keeps the spin's axis;
+// it only takes energy out, and only from spins no step resolves.
+void WorldImpl::CapSpin(double dt) {
+  const double max_speed = settings_.max_turn_per_step / dt;
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.awake || body.disabled) continue;
+    const double end_speed = body.angular_velocity.norm();
+    const double start_speed = (body.inverse_inertia_world * body.start_angular_momentum).norm();
+    // A NaN speed fails both tests and passes on to the step guard as is.
+    if (end_speed > max_speed) {
+      body.angular_momentum *= max_speed / end_speed;
+      body.UpdateDerived();
+    }
+    if (start_speed > max_speed) body.start_angular_momentum *= max_speed / start_speed;
+  }
+}
+
+// The awake bodies drift over the step; each one's path (start, end and
+// velocities) is kept for the time-of-impact search. paths_ is kept between
+// steps, so that a step neither allocates nor clears a path per body.
+void WorldImpl::DriftBodies(double dt) {
+  CapSpin(dt);
+  paths_.resize(bodies_.size());
+  for (const std::uint32_t i : moving_bodies_) {
+    const Body& body = bodies_[i];
+    if (!body.awake) continue;
+    BodyPath& path = paths_[i];
+    path.start = body.WorldFromPrincipal();
+    path.start_velocity = body.start_linear_velocity;
+    path.end_velocity = body.linear_velocity;
+    path.pseudo_velocity = body.pseudo_linear_velocity;
+    path.dt = dt;
+  }
+  IntegratePositions(dt, moving_bodies_, &bodies_);
+  DisableNonFiniteBodies();
+  for (const std::uint32_t i : moving_bodies_) {
+    if (bodies_[i].disabled) paths_[i].dt = 0.0;
+    BodyPath& path = paths_[i];
+    if (path.dt == 0.0) continue;
+    path.end = bodies_[i].WorldFromPrincipal();
+    path.turn =
+        TurnBetween(path.start.rotation, path.end.rotation, dt * bodies_[i].angular_velocity);
+  }
+}
+
+// Per body, once: whether it moves more than continuous_fraction of its
+// thickness (fast: sampled along its path), and how far any of its points
+// can move over the step, m. The centre's parabola never leaves the ball of
+// radius dt max(|v0|, |v1|) (the velocity is linear in t); add the
+// split-impulse drift and the slerp angle times the shapes' reach from the
+// centre.
+void WorldImpl::BoundBodyMotion(double dt) {
+  for (const std::uint32_t i : moving_bodies_) {
+    BodyPath& path = paths_[i];
+    if (path.dt == 0.0) continue;
+    const double angle = path.turn.norm();
+    const double radius = bodies_[i].bounding_radius;
+    const double displacement = (path.end.translation - path.start.translation).norm();
+    path.fast =
+        displacement + angle * radius > settings_.continuous_fraction * bodies_[i].thickness;
+    path.reach = dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
+                       path.pseudo_velocity.norm()) +
+                 angle * radius;
+    bodies_[i].travel += path.reach;
+  }
+}
+
+// Candidate pairs: a pair with no touching point at the start (a new
+// contact, which the solver has not seen), and every pair of a fast body;
+// pairs already touching are the resting solver's.
+// Each pair's search reads the bodies and their paths and writes only its
+// own entry, so the pairs are searched on the pool, and the impacts listed
+// afterwards in the pairs' order: the same list for any number of threads.
+std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs) {
+  // A pair's search costs 0.1-10 us; a chunk this long amortizes taking it.
+  constexpr std::size_t kPairsPerChunk = 64;
+  impact_searches_.resize(pairs.size());
+  pool_->ParallelFor(pairs.size(), kPairsPerChunk, [&](std::size_t e) {
+    PrefetchAhead(pairs, e, PrefetchManifold);
+    ShapePairContact* pair = pairs[e];
+    ImpactSearch& search = impact_searches_[e];
+    search.time = std::numeric_limits<double>::infinity();
+    if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) return;
+    // A link's contacts are the articulation solve's, which lets no point
+    // close more than its gap within a step.
+    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0) {
+      return;
+    }
+    search.time = PairImpactTime(dt, pair, &search.approach_speed);
+  });
+  std::vector<Impact> impacts;
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const ImpactSearch& search = impact_searches_[e];
+    if (!std::isfinite(search.time)) continue;
+    const bool colliding = search.approach_speed > settings_.solver.collision_velocity_threshold;
+    impacts.push_back(Impact{pairs[e], search.time, colliding});
+  }
+  return impacts;
+}
+
+// The time within the step at which the pair comes within the touching band,
+// or +infinity when it does not or is already in contact.
+double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* approach_speed) {
+  constexpr double kNoImpact = std::numeric_limits<double>::infinity();
+  *approach_speed = 0.0;
+  double touching = settings_.solver.contact_tolerance;
+  // The search stops within 5 % of the touching band above the surface, so
+  // the speed at the impact is free fall's to g (0.05 epsilon) / v^2:
+  // 2.6e-7 of it after a 1 m drop.
+  double target_gap = 0.05 * touching;
+  const BodyPath& path_a = paths_[pair->body_a];
+  const BodyPath& path_b = paths_[pair->body_b];
+  // The gap at the start: the nearest point of the manifold, or, with no
+  // point, at least the distance the narrow phase looked within, and at
+  // least the narrow phase's separating-axis gap less what the bodies
+  // travelled between that test and the start of this step.
+  const double travel_since = bodies_[pair->body_a].travel - path_a.reach +
+                              bodies_[pair->body_b].travel - path_b.reach - pair->apart_travel;
+  double start_gap = std::max(pair->contact_distance, pair->apart_gap - travel_since);
+  for (int i = 0; i < pair->manifold.point_count; ++i) {
+    start_gap = std::min(start_gap, pair->manifold.points[i].separation);
+  }
+  const bool fast = path_a.fast || path_b.fast;
+  if (start_gap <= touching && !fast) return kNoImpact;
+  if (bodies_[pair->body_a].disabled || bodies_[pair->body_b].disabled) return kNoImpact;
+  if (start_gap <= touching) {
+    // Already in contact, and fast (a small body spinning on a corner): the
+    // solver holds the points it touches at, and the search only keeps
+    // another feature from passing through the other body. Backing up to
+    // the first touch of a feature would return t = 0 step after step and
+    // freeze the body in place with its velocity. The depth allowed is the
+    // motion per sample of a fast body, so nothing thicker than four times
+    // it can be passed through.
+    const double depth = settings_.continuous_fraction * PairThickness(*pair);
+    touching = start_gap - 0.5 * depth;
+    target_gap = start_gap - depth;
+  }
+  // Two bodies that cannot close their gap within the step need no search
+  // (a reused manifold's gap is known to within its reuse error).
+  const double reach = path_a.reach + path_b.reach;
+  if (start_gap - pair->reuse_error - reach > target_gap) return kNoImpact;
+  if (start_gap <= target_gap) return kNoImpact;  // already in contact: the solver's business
+  const PairSweep sweep{&paths_[pair->body_a],
+                        &bodies_[pair->body_a],
+                        &paths_[pair->body_b],
+                        &bodies_[pair->body_b],
+                        pair->shape_a,
+                        pair->shape_b,
+                        std::max(start_gap, 0.0) + reach + settings_.contact_margin,
+                        ShapeRadius(bodies_[pair->body_a].shapes[pair->shape_a].geometry),
+                        ShapeRadius(bodies_[pair->body_b].shapes[pair->shape_b].geometry)};
+  // Most pairs that get here end the step still apart, such as boxes side
+  // by side with a gap below their manifold's reuse error. Asking only
+  // whether they are apart by more than target_gap at the end lets the
+  // pair's cached separating axis answer, a lower bound on the distance, in
+  // a fraction of a full test (Baraff 1997, "Rigid Body Simulation II",
+  // section 7.1, the cached separating plane).
+  const int samples = fast ? PathSamples(pair->body_a, pair->body_b) : 1;
+  if (samples == 1) {
+    SeparatingWitness witness = pair->witness;
+    ContactManifold manifold;
+    if (!Collide(sweep.InputAt(dt, target_gap), &witness, &manifold)) return kNoImpact;
+  }
+  ImpactBracket bracket{0.0, start_gap, -1.0, 0.0};
+  for (int k = 1; k <= samples; ++k) {
+    const double t = dt * k / samples;
+    const double bound = sweep.SphereGapAt(t);
+    const double gap = bound > target_gap ? bound : sweep.GapAt(t);
+    if (gap <= target_gap) {
+      bracket.high = t;
+      bracket.gap_high = gap;
+      break;
+    }
+    bracket.low = t;
+    bracket.gap_low = gap;
+  }
+  if (bracket.high < 0.0) return kNoImpact;
+  // The pair is about to touch: next step clips it afresh, so that the
+  // solver and this search see the same gap (a reused manifold's can be off
+  // by its reuse error, and a pair backed up to t = 0 again and again would
+  // never reach the solver).
+  pair->anchors.valid = false;
+  bracket = NarrowImpactBracket(sweep, target_gap, touching, dt, bracket);
+  // The gap's rate over the final bracket: the speed the surfaces meet at.
+  *approach_speed = (bracket.gap_low - bracket.gap_high) / (bracket.high - bracket.low);
+  return bracket.low;
+}
+
+// m; the thinner moving body of the pair (a static one never moves through
+// anything).
+double WorldImpl::PairThickness(const ShapePairContact& pair) const {
+  double thickness = std::numeric_limits<double>::infinity();
+  for (const std::uint32_t index : {pair.body_a, pair.body_b}) {
+    if (paths_[index].dt > 0.0) thickness = std::min(thickness, bodies_[index].thickness);
+  }
+  return thickness;
+}
+
+// Samples along the faster body's path, so that no sample moves it more than
+// continuous_fraction of its thickness.
+int WorldImpl::PathSamples(std::uint32_t body_a, std::uint32_t body_b) const {
+  double motion = 0.0;
+  for (const std::uint32_t index : {body_a, body_b}) {
+    const BodyPath& path = paths_[index];
+    if (path.dt == 0.0) continue;
+    const double displacement = (path.end.translation - path.start.translation).norm() +
+                                path.turn.norm() * bodies_[index].bounding_radius;
+    motion =
+        std::max(motion, displacement / (settings_.continuous_fraction * bodies_[index].thickness));
+  }
+  return static_cast<int>(std::clamp(std::ceil(motion), 1.0, kMaxPathSamples));
+}
+
+// Only moving bodies change state within a step, so only they are checked.
+void WorldImpl::DisableNonFiniteBodies() {
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
+    // Its cached pairs are no longer seen from the next step on, and go.
+    DisableBody(i);
+  }
+}
+
+// Out of the simulation until it is given a finite state: asleep, out of
+// the broad phase, and reported once in non_finite_bodies_.
+void WorldImpl::DisableBody(std::uint32_t index) {
+  Body& body = bodies_[index];
+  body.disabled = true;
+  body.awake = false;
+  woke_since_prune_ = true;
+  if (body.has_proxy) {
+    broad_phase_.RemoveProxy(static_cast<int>(index));
+    body.has_proxy = false;
+  }
+  const BodyId id{index, body.generation};
+  if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
+      non_finite_bodies_.end()) {
+    non_finite_bodies_.push_back(id);
+  }
+}
+
+// Whether a body has kept speeding up for sleep.speeding_up_time. Slow is
+// not at rest: a box on a slope 0.2 degrees steeper than its friction angle
+// accelerates at 0.04 m/s^2 and stays below 0.05 m/s for 1.3 s, long enough
+// to fall asleep mid-slide. A settling body's speed rises and falls from
+// step to step; one getting under way gains speed at every step. Speeds
+// below 2 % of the sleep thresholds are noise: the residual velocities of a
+// stack at rest can grow steadily without going anywhere, and counted, they
+// kept the benchmark's pyramids awake.
+bool WorldImpl::UpdateSpeedingUp(double dt, Body* body) const {
+  constexpr double kNoiseFraction = 0.02;
+  const SleepSettings& sleep = settings_.sleep;
+  const double speed = body->linear_velocity.norm();
+  const double angular_speed = body->angular_velocity.norm();
+  const bool gaining =
+      (speed > body->last_speed && speed > kNoiseFraction * sleep.linear_velocity) ||
+      (angular_speed > body->last_angular_speed &&
+       angular_speed > kNoiseFraction * sleep.angular_velocity);
+  body->last_speed = speed;
+  body->last_angular_speed = angular_speed;
+  body->speeding_up_time = gaining ? body->speeding_up_time + dt : 0.0;
+  return sleep.speeding_up_time > 0.0 && body->speeding_up_time >= sleep.speeding_up_time;
+}
+
+// Islands are the connected components of the contact graph through moving
+// bodies (union-find). An island sleeps when every body in it has been slower
+// than the thresholds, or has kept within its sleep window, and not speeding
+// up, for time_to_sleep; it costs nothing until woken.
+void WorldImpl::UpdateSleep(double dt) {
+  const SleepSettings& sleep = settings_.sleep;
+  if (!sleep.enabled) return;
+  UnionFind islands(bodies_.size());
+  for (const ShapePairContact* pair : contact_cache_.touching()) {
+    const Body& a = bodies_[pair->body_a];
+    const Body& b = bodies_[pair->body_b];
+    if (a.is_static || b.is_static) continue;
+    islands.Join(pair->body_a, pair->body_b);
+  }
+  // Articulations never sleep, nor does what touches them.
+  std::vector<char> island_has_link(bodies_.size(), 0);
+  for (const ShapePairContact* pair : link_pairs_) {
+    for (const std::uint32_t index : {pair->body_a, pair->body_b}) {
+      if (bodies_[index].articulation >= 0) island_has_link[islands.Find(index)] = 1;
+    }
+  }
+  std::vector<double> island_sleep_time(bodies_.size(), std::numeric_limits<double>::infinity());
+  sleep_windows_.resize(bodies_.size());
+  const SleepWindowLimits limits =
+      MakeSleepWindowLimits(sleep.linear_velocity, sleep.angular_velocity, sleep.time_to_sleep);
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.awake) continue;
+    const bool speeding_up = UpdateSpeedingUp(dt, &body);
+    if (island_has_link[islands.Find(i)]) {
+      // Held by, resting on or pushed by a link: its quiet time starts
+      // over, so that once the link lets go it must be quiet for
+      // time_to_sleep again; counted on, a box held still for a second fell
+      // asleep in mid-air the step the gripper opened.
+      body.sleep_time = 0.0;
+      RestartSleepWindow(i);
+      island_sleep_time[islands.Find(i)] = 0.0;
+      continue;
+    }
+    const bool slow =
+        !speeding_up &&
+        body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
+        body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
+    body.sleep_time = slow ? body.sleep_time + dt : 0.0;
+    // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
+    if (speeding_up) RestartSleepWindow(i);
+    const double still_time =
+        UpdateSleepWindow(body.WorldFromPrincipal(), limits, dt, &sleep_windows_[i]);
+    const double quiet_time = std::max(body.sleep_time, still_time);
+    double& island = island_sleep_time[islands.Find(i)];
+    island = std::min(island, quiet_time);
+  }
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.awake) continue;
+    if (island_sleep_time[islands.Find(i)] < sleep.time_to_sleep) continue;
+    body.awake = false;
+    body.linear_momentum.setZero();
+    body.angular_momentum.setZero();
+    body.UpdateDerived();
+  }
+}
+
+}  // namespace rigid_body_sim::physics

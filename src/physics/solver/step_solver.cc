@@ -1,0 +1,350 @@
+// Stage 4 of WorldImpl::Step, in Baraff's order: colliding contacts get impulses
+// on the velocities the step starts with; then gravity and the applied
+// forces act; then resting contacts get the impulses that keep them apart.
+#include <algorithm>
+#include <cmath>
+
+#include "physics/dynamics/integrator.h"
+#include "physics/collision/mesh_collision.h"
+#include "physics/world/world_impl.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// The collision log keeps at most this many points when nobody reads it.
+constexpr std::size_t kMaxCollisionLogSize = 100000;
+
+// The solver's copy of the moving bodies; the other bodies the contacts
+// reach (static or asleep) get zero inverse mass and inertia. Bodies no
+// contact reaches are left as they are: the solver never reads them.
+void LoadVelocities(const std::vector<Body>& bodies, const std::vector<std::uint32_t>& moving,
+                    const std::vector<ShapePairContact*>& pairs,
+                    std::vector<SolverBody>* solver_bodies) {
+  for (const ShapePairContact* pair : pairs) {
+    (*solver_bodies)[pair->body_a] = SolverBody();
+    (*solver_bodies)[pair->body_b] = SolverBody();
+  }
+  for (const std::uint32_t i : moving) {
+    const Body& body = bodies[i];
+    SolverBody& solver_body = (*solver_bodies)[i];
+    solver_body = SolverBody();
+    if (body.disabled) continue;
+    solver_body.linear_velocity = body.linear_velocity;
+    solver_body.angular_velocity = body.angular_velocity;
+    solver_body.inverse_mass = body.inverse_mass;
+    solver_body.inverse_inertia_world = body.inverse_inertia_world;
+  }
+}
+
+// P = M v and L = I_world omega, with I_world = R diag(I) R^T.
+void StoreVelocities(const std::vector<SolverBody>& solver_bodies,
+                     const std::vector<std::uint32_t>& moving, std::vector<Body>* bodies) {
+  for (const std::uint32_t i : moving) {
+    Body& body = (*bodies)[i];
+    if (body.disabled) continue;
+    const SolverBody& solver_body = solver_bodies[i];
+    body.linear_momentum = body.mass * solver_body.linear_velocity;
+    const Mat3 rotation = body.orientation.toRotationMatrix();
+    body.angular_momentum = rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+                            (rotation.transpose() * solver_body.angular_velocity);
+    body.pseudo_linear_velocity = solver_body.pseudo_linear_velocity;
+    body.pseudo_angular_velocity = solver_body.pseudo_angular_velocity;
+    body.UpdateDerived();
+  }
+}
+
+}  // namespace
+
+// A resting report of point i of a pair from its cached impulses, with
+// `tangent` the basis of its normal (TangentBasis) that they are in; the
+// solver overwrites what it knows better for the pairs it solved.
+ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
+                                    const std::array<Vec3, 2>& tangent, double dt) const {
+  const ContactPoint& contact = pair.manifold.points[i];
+  const CachedImpulse& impulse = pair.previous[i];
+  ContactReport report;
+  report.body_a = BodyId{pair.body_a, bodies_[pair.body_a].generation};
+  report.body_b = BodyId{pair.body_b, bodies_[pair.body_b].generation};
+  // A static mesh's slot copies report as the mesh (mesh_collision.h).
+  report.shape_a = CallerShape(bodies_[pair.body_a].shapes, pair.shape_a);
+  report.shape_b = CallerShape(bodies_[pair.body_b].shapes, pair.shape_b);
+  report.position_world = contact.position_world;
+  report.normal_world = pair.manifold.normal_world;
+  report.depth = std::max(0.0, -contact.separation);
+  report.type = ContactType::kResting;
+  report.normal_impulse = impulse.normal_impulse;
+  report.friction_impulse_world =
+      impulse.tangent_impulse[0] * tangent[0] + impulse.tangent_impulse[1] * tangent[1];
+  report.normal_force = report.normal_impulse / dt;
+  return report;
+}
+
+// A support that is new this step (a pair that had no contact point last
+// step, and touches at every point now) starts the resting solve from the
+// load it would carry at rest, instead of from zero. Statics of a stack,
+// from the highest body down: a body's load is its weight m g dt plus the
+// loads resting on it; the part its warm supports do not carry already
+// (their impulses n / (n.up)) is shared equally by its new supports, whose
+// points take the normal part n.up of their share; each support passes its
+// load to the body below. Without it, Gauss-Seidel sweeps from zero move a
+// load up a stack by about one level per sweep, so a stack spawned at rest
+// sags and rocks for its first tenth of a second. The estimate is only
+// where the iteration starts: the complementarity conditions, and so the
+// solution, are the same.
+void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt) {
+  const double g = settings_.gravity.norm();
+  if (g <= 0.0) return;
+  const Vec3 up = -settings_.gravity / g;
+  // A support is upright when its normal is within 60 degrees of up.
+  constexpr double kUpright = 0.5;
+  struct Support {
+    std::uint32_t manifold;
+    std::uint32_t upper;
+    std::uint32_t lower;
+    bool is_new;
+    double up_along_normal;  // n.up, > kUpright
+  };
+  std::vector<Support> supports;
+  bool any_new = false;
+  std::vector<SolverManifold>& manifolds = solver_.manifolds();
+  for (std::uint32_t m = 0; m < manifolds.size(); ++m) {
+    const SolverManifold& manifold = manifolds[m];
+    const double up_along_normal = manifold.normal_world.dot(up);  // the normal points to A
+    if (std::abs(up_along_normal) <= kUpright || manifold.point_count == 0) continue;
+    bool is_new = pairs[m]->previous_count == 0;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      is_new &= manifold.points[i].separation <= settings_.solver.contact_tolerance;
+    }
+    any_new |= is_new;
+    if (up_along_normal > 0.0) {
+      supports.push_back({m, manifold.body_a, manifold.body_b, is_new, up_along_normal});
+    } else {
+      supports.push_back({m, manifold.body_b, manifold.body_a, is_new, -up_along_normal});
+    }
+  }
+  if (!any_new) return;
+  // Highest upper body first, so that a body's load is complete before it
+  // is passed on; ties by index, for the same result on every run.
+  auto height = [&](std::uint32_t body) { return bodies_[body].position.dot(up); };
+  std::sort(supports.begin(), supports.end(), [&](const Support& x, const Support& y) {
+    const double hx = height(x.upper);
+    const double hy = height(y.upper);
+    return hx != hy ? hx > hy : x.upper < y.upper;
+  });
+  auto carries_load = [&](std::uint32_t body) {
+    const Body& b = bodies_[body];
+    return !b.is_static && b.awake && !b.disabled;
+  };
+  // N s: a body's load; then, from its first support on, what its new
+  // supports share.
+  std::vector<double> load(bodies_.size(), 0.0);
+  std::vector<int> new_supports(bodies_.size(), 0);
+  for (const Support& support : supports) {
+    load[support.upper] = bodies_[support.upper].mass * g * dt;
+    if (support.is_new) ++new_supports[support.upper];
+  }
+  auto warm_load = [&](const Support& support) {
+    const SolverManifold& manifold = manifolds[support.manifold];
+    double normal = 0.0;
+    for (int i = 0; i < manifold.point_count; ++i) normal += manifold.points[i].normal_impulse;
+    return normal / support.up_along_normal;
+  };
+  for (std::size_t k = 0; k < supports.size(); ++k) {
+    const std::uint32_t upper = supports[k].upper;
+    if (k == 0 || supports[k - 1].upper != upper) {
+      for (std::size_t w = k; w < supports.size() && supports[w].upper == upper; ++w) {
+        if (!supports[w].is_new) load[upper] -= warm_load(supports[w]);
+      }
+      load[upper] = std::max(load[upper], 0.0);
+    }
+    const Support& support = supports[k];
+    double passed = 0.0;
+    if (!support.is_new) {
+      passed = warm_load(support);
+    } else if (carries_load(upper)) {
+      passed = load[upper] / new_supports[upper];
+      SolverManifold& manifold = manifolds[support.manifold];
+      const double per_point = passed * support.up_along_normal / manifold.point_count;
+      for (int i = 0; i < manifold.point_count; ++i) manifold.points[i].normal_impulse = per_point;
+    }
+    if (carries_load(support.lower)) load[support.lower] += passed;
+  }
+}
+
+// Baraff's order within a step: colliding contacts get impulses on the
+// velocities the step starts with, then the forces act, then the resting
+// contacts get the impulses that keep them apart, all contacts at once.
+void WorldImpl::SolveContacts(double dt) {
+  // The bodies that move this step; the stages from here on visit only
+  // them, so sleeping bodies cost nothing.
+  moving_bodies_.clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Body& body = bodies_[i];
+    if (body.in_use && !body.is_static && body.awake && !body.disabled && body.articulation < 0) {
+      moving_bodies_.push_back(i);
+    }
+  }
+  // The contact solver takes the pairs of rigid bodies; the articulations'
+  // solve, after it, the pairs with a link (step_articulations.cc).
+  SplitLinkPairs(contact_cache_.touching());
+  SolveTouching(dt, rigid_pairs_);
+  SolveArticulations(dt);
+  ReportContacts(rigid_pairs_, dt, /*impacts_only=*/false);
+  ReportLinkContacts(dt);
+}
+
+// The contact solve of the touching pairs over dt, for the bodies of
+// moving_bodies_; the others are held where they are.
+void WorldImpl::SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs) {
+  solver_.Reset(settings_.solver, dt, bodies_.size());
+  LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
+  BuildSolverManifolds(pairs);
+  SeedNewSupportLoads(pairs, dt);
+  solver_.Prepare();
+
+  solver_.ResolveCollisions();
+  solver_.RecordStartVelocities();
+  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
+  IntegrateForces(settings_.gravity, dt, moving_bodies_, &bodies_);
+  DisableNonFiniteBodies();
+  LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
+  solver_.SolveRestingContacts();
+  StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
+  HoldPushedBodies();
+}
+
+// A body that resting contact pushed this step drifts with its end velocity
+// along the contact normal (symplectic Euler), so it does not sink while
+// held; across the normal it keeps the trapezoid, dt/2 (v_start + v_end),
+// exact for a constant force such as kinetic friction on a sliding box
+// (integrator.h). A body pushed along two directions that are not parallel
+// (a box in a corner, one in a stack leaning on a neighbour) drifts with its
+// end velocity and its end angular momentum throughout.
+void WorldImpl::HoldPushedBodies() {
+  constexpr double kParallelSine = 1e-9;
+  push_normals_.resize(bodies_.size());
+  push_state_.assign(bodies_.size(), 0);
+  for (const SolverManifold& manifold : solver_.manifolds()) {
+    bool pushed = false;
+    for (int i = 0; i < manifold.point_count; ++i)
+      pushed |= manifold.points[i].normal_impulse > 0.0;
+    if (!pushed) continue;
+    for (const std::uint32_t index : {manifold.body_a, manifold.body_b}) {
+      std::uint8_t& state = push_state_[index];
+      if (state == 0) {
+        push_normals_[index] = manifold.normal_world;
+        state = 1;
+      } else if (push_normals_[index].cross(manifold.normal_world).norm() > kParallelSine) {
+        state = 2;
+      }
+    }
+  }
+  const double impulsive = settings_.solver.collision_velocity_threshold;
+  for (const std::uint32_t index : moving_bodies_) {
+    Body& body = bodies_[index];
+    const Vec3& n = push_normals_[index];
+    const double normal_change = n.dot(body.linear_velocity - body.start_linear_velocity);
+    // The change along the normal is a force's only while the body rests;
+    // one that stops an approach (an inelastic landing) is an impulse at the
+    // start of the step, and the end velocity holds throughout.
+    if (push_state_[index] == 1 && std::abs(normal_change) <= impulsive) {
+      body.start_linear_velocity += n * normal_change;
+      body.start_angular_momentum = body.angular_momentum;
+    } else if (push_state_[index] != 0) {
+      body.start_linear_velocity = body.linear_velocity;
+      body.start_angular_momentum = body.angular_momentum;
+    }
+  }
+}
+
+// One solver manifold per touching pair, with its points' lever arms,
+// combined materials and last step's impulses.
+void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs) {
+  std::vector<SolverManifold>& manifolds = solver_.manifolds();
+  manifolds.reserve(pairs.size());
+  for (std::size_t m = 0; m < pairs.size(); ++m) {
+    PrefetchAhead(pairs, m, PrefetchPoints);
+    const ShapePairContact* pair = pairs[m];
+    const Body& a = bodies_[pair->body_a];
+    const Body& b = bodies_[pair->body_b];
+    // Built in place: a manifold with its four points is 648 bytes.
+    SolverManifold& manifold = manifolds.emplace_back();
+    manifold.body_a = pair->body_a;
+    manifold.body_b = pair->body_b;
+    manifold.normal_world = pair->manifold.normal_world;
+    const Material& material_a = a.shapes[pair->shape_a].material;
+    const Material& material_b = b.shapes[pair->shape_b].material;
+    manifold.friction = CombineFriction(material_a.friction, material_b.friction);
+    manifold.restitution = CombineRestitution(material_a.restitution, material_b.restitution);
+    manifold.point_count = pair->manifold.point_count;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      const ContactPoint& contact = pair->manifold.points[i];
+      SolverPoint& point = manifold.points[i];
+      point.r_a = contact.position_world - a.position;
+      point.r_b = contact.position_world - b.position;
+      point.separation = contact.separation;
+      point.feature = contact.feature;
+      point.normal_impulse = pair->warm_start[i].normal_impulse;
+      point.tangent_impulse = pair->warm_start[i].tangent_impulse;
+    }
+  }
+}
+
+// Keeps the impulses for next step's warm start, and reports the points
+// that touch, after the sleeping pairs' reports.
+void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt,
+                               bool impacts_only) {
+  const std::vector<SolverManifold>& manifolds = solver_.manifolds();
+  if (!impacts_only) ReportSleepingContacts(dt);
+  for (std::size_t m = 0; m < manifolds.size(); ++m) {
+    PrefetchAhead(pairs, m, PrefetchPoints);
+    const SolverManifold& manifold = manifolds[m];
+    ShapePairContact& pair = *pairs[m];
+    pair.previous_count = manifold.point_count;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      const SolverPoint& point = manifold.points[i];
+      pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse,
+                                       pair.manifold.points[i].position_world};
+      const bool touching = point.separation <= settings_.solver.contact_tolerance;
+      const double impulse = point.collision_impulse + point.normal_impulse;
+      // A collision is reported only where an impulse resolved it; a
+      // sub-step after an impact reports only its collisions, the step's
+      // own report holding the resting contacts.
+      const bool collided = point.type == ContactType::kColliding && impulse > 0.0;
+      const bool reported = point.type == ContactType::kColliding ? collided : touching;
+      if (!reported || (impacts_only && !collided)) continue;
+      ContactReport& report =
+          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, dt));
+      report.normal_velocity = point.normal_velocity_before;
+      report.type = point.type;
+      report.normal_impulse = impulse;
+      report.normal_force = report.normal_impulse / dt;
+      if (report.type == ContactType::kColliding) collision_log_.push_back(report);
+    }
+  }
+  if (collision_log_.size() > kMaxCollisionLogSize) {
+    collision_log_.erase(collision_log_.begin(),
+                         collision_log_.end() - static_cast<std::ptrdiff_t>(kMaxCollisionLogSize));
+  }
+}
+
+// Sleeping bodies keep the contacts they fell asleep with; their reports are
+// made again only when the list of sleeping pairs changes, and the reports
+// of this step follow them.
+void WorldImpl::ReportSleepingContacts(double dt) {
+  if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
+    contacts_.clear();
+    for (const ShapePairContact* pair : contact_cache_.sleeping()) {
+      const std::array<Vec3, 2> tangent = TangentBasis(pair->manifold.normal_world);
+      for (int i = 0; i < pair->manifold.point_count; ++i) {
+        if (pair->manifold.points[i].separation > settings_.solver.contact_tolerance) continue;
+        contacts_.push_back(MakeReport(*pair, i, tangent, dt));
+      }
+    }
+    sleeping_reports_version_ = contact_cache_.sleeping_version();
+    sleeping_report_count_ = contacts_.size();
+  }
+  contacts_.resize(sleeping_report_count_);
+}
+
+}  // namespace rigid_body_sim::physics

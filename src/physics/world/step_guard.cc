@@ -1,0 +1,104 @@
+// The step guard around the stages of WorldImpl::Step: no body's state that
+// is not finite, or so large that a step's products overflow, ever reaches
+// another body. Before the stages, a body whose state or pending force is
+// out of bounds is frozen where it is; after them, a body whose state is not
+// finite goes back to its pose at the start of the step and is frozen there.
+// Frozen is `disabled`: held still, out of the broad phase and the solver,
+// its contacts dropped, until SetState gives it a state again.
+#include <algorithm>
+#include <cmath>
+
+#include "physics/world/world_impl.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// Bound on each of position (m), velocity (m/s), angular velocity (rad/s)
+// and the velocity changes a step's forces give. The stages multiply at most
+// three such quantities together (a lever arm times a mass times a
+// velocity, a squared speed times a mass), so below 1e100 each, nothing a
+// step computes overflows a double (1.8e308). No physical scene comes near.
+constexpr double kMaxMagnitude = 1e100;
+// Momenta are a mass or an inertia times a velocity.
+constexpr double kMaxMomentum = kMaxMagnitude * kMaxMagnitude;
+
+bool Within(const Vec3& v, double bound) {
+  // Written so that NaN fails: !(NaN <= bound).
+  return v.allFinite() && v.norm() <= bound;
+}
+
+// Whether the body's state, and the step its pending force and torque would
+// give it, stay within the bounds.
+bool StepIsSafe(const Body& body, double dt) {
+  if (!body.HasFiniteState() || !body.force.allFinite() || !body.torque.allFinite()) return false;
+  if (!Within(body.position, kMaxMagnitude) || !Within(body.linear_momentum, kMaxMomentum) ||
+      !Within(body.angular_momentum, kMaxMomentum)) {
+    return false;
+  }
+  const Vec3 velocity_change = dt * body.inverse_mass * body.force;
+  const Vec3 spin_change = dt * (body.inverse_inertia_world * body.torque);
+  return Within(body.linear_velocity, kMaxMagnitude) &&
+         Within(body.angular_velocity, kMaxMagnitude) && Within(velocity_change, kMaxMagnitude) &&
+         Within(spin_change, kMaxMagnitude);
+}
+
+bool StateIsSafe(const Body& body) {
+  return body.HasFiniteState() && Within(body.position, kMaxMagnitude) &&
+         Within(body.linear_momentum, kMaxMomentum) &&
+         Within(body.angular_momentum, kMaxMomentum) &&
+         Within(body.linear_velocity, kMaxMagnitude) &&
+         Within(body.angular_velocity, kMaxMagnitude);
+}
+
+}  // namespace
+
+void WorldImpl::GuardBeforeStep(double dt) {
+  guard_start_poses_.resize(bodies_.size());
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    Body& body = bodies_[i];
+    // A link's state is its articulation's, which guards it as a whole.
+    if (!body.in_use || body.is_static || body.disabled || body.articulation >= 0) continue;
+    const bool pose_is_finite = body.position.allFinite() && IsFinite(body.orientation);
+    if (pose_is_finite) guard_start_poses_[i] = body.WorldFromPrincipal();
+    if (!body.awake || StepIsSafe(body, dt)) continue;
+    // A pose that is not finite cannot come from the API (it refuses one),
+    // so the start of the step is the last finite pose there is.
+    FreezeBody(i, pose_is_finite ? body.WorldFromPrincipal() : guard_start_poses_[i]);
+  }
+}
+
+void WorldImpl::GuardAfterStep() {
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Body& body = bodies_[i];
+    if (!body.in_use || body.is_static || body.articulation >= 0) continue;
+    // A body the stages disabled for a state that is not finite still holds
+    // that state; one frozen here before holds a finite one.
+    if (body.disabled ? body.HasFiniteState() : StateIsSafe(body)) continue;
+    FreezeBody(i, guard_start_poses_[i]);
+  }
+}
+
+void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal) {
+  Body& body = bodies_[index];
+  body.position = world_from_principal.translation;
+  body.orientation = world_from_principal.rotation;
+  for (Vec3* v : {&body.linear_momentum, &body.angular_momentum, &body.force, &body.torque,
+                  &body.start_linear_velocity, &body.start_angular_momentum,
+                  &body.pseudo_linear_velocity, &body.pseudo_angular_velocity}) {
+    v->setZero();
+  }
+  body.UpdateDerived();
+  DisableBody(index);
+  contact_cache_.RemoveBody(index);
+  const auto touches = [index](const ContactReport& contact) {
+    return contact.body_a.index == index || contact.body_b.index == index;
+  };
+  contacts_.erase(std::remove_if(contacts_.begin(), contacts_.end(), touches), contacts_.end());
+  collision_log_.erase(std::remove_if(collision_log_.begin(), collision_log_.end(), touches),
+                       collision_log_.end());
+  // The sleeping pairs' reports at the front of contacts_ are made afresh.
+  sleeping_reports_version_ = ~std::uint64_t{0};
+  sleeping_report_count_ = 0;
+}
+
+}  // namespace rigid_body_sim::physics

@@ -1,0 +1,75 @@
+// A small fork-join pool of threads for the stages of a step: the caller and
+// threads() - 1 workers run one task together, and the call returns when all
+// of them have finished it. The stages hand it work whose result does not
+// depend on which thread does which part (each part writes only its own
+// outputs), so a step's result is the same for any number of threads.
+#ifndef RIGID_BODY_SIM_PHYSICS_WORLD_TASK_POOL_H_
+#define RIGID_BODY_SIM_PHYSICS_WORLD_TASK_POOL_H_
+
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace rigid_body_sim::physics {
+
+class TaskPool {
+ public:
+  // `threads` >= 1 threads in all, the caller's included; 1 starts none.
+  explicit TaskPool(int threads = 1);
+  ~TaskPool();
+  TaskPool(const TaskPool&) = delete;
+  TaskPool& operator=(const TaskPool&) = delete;
+
+  int threads() const { return static_cast<int>(workers_.size()) + 1; }
+
+  // Runs task(t) once for each t in [0, threads()), t = 0 on the calling
+  // thread, and returns when every call has returned. Not reentrant: a
+  // task must not call RunOnAll.
+  void RunOnAll(const std::function<void(int)>& task);
+
+  // Calls body(i) for every i in [0, count): the threads take chunks of
+  // `chunk` consecutive indices in turn until none are left, so uneven
+  // parts balance. Which thread runs an index is left to the schedule;
+  // body must write only what index i owns.
+  template <typename Body>
+  void ParallelFor(std::size_t count, std::size_t chunk, const Body& body) {
+    if (threads() == 1 || count <= chunk) {
+      for (std::size_t i = 0; i < count; ++i) body(i);
+      return;
+    }
+    std::atomic<std::size_t> next{0};
+    RunOnAll([&](int) {
+      for (;;) {
+        const std::size_t begin = next.fetch_add(chunk, std::memory_order_relaxed);
+        if (begin >= count) return;
+        const std::size_t end = begin + chunk < count ? begin + chunk : count;
+        for (std::size_t i = begin; i < end; ++i) body(i);
+      }
+    });
+  }
+
+ private:
+  void WorkerLoop(int index);
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_;  // a new task, or stop_
+  std::condition_variable done_;   // pending_ reached 0
+  const std::function<void(int)>* task_ = nullptr;
+  std::uint64_t generation_ = 0;  // counts the tasks handed out
+  int pending_ = 0;               // workers still running the current task
+  bool stop_ = false;
+};
+
+// The threads a `threads` setting asks for: itself, or for 0 every core the
+// system reports (at least 1).
+int ResolveThreadCount(int threads);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_WORLD_TASK_POOL_H_

@@ -1,0 +1,374 @@
+#include "physics/world/world_impl.h"
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <variant>
+
+#include "physics/collision/mesh_collision.h"
+#include "physics/geometry/shape_bounds.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+constexpr double kUnitQuaternionTolerance = 1e-6;
+// Limits of the contact cache's keys.
+constexpr std::size_t kMaxShapesPerBody = 4096;
+constexpr std::size_t kMaxBodies = std::size_t{1} << 20;
+
+std::string Describe(const Vec3& v) {
+  std::ostringstream out;
+  out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return out.str();
+}
+
+}  // namespace
+
+Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
+                     const Vec3& angular_velocity) {
+  if (!IsFinite(world_from_body.translation)) {
+    return Status::Error("position is not finite: " + Describe(world_from_body.translation));
+  }
+  if (!IsFinite(world_from_body.rotation)) {
+    return Status::Error("orientation quaternion is not finite");
+  }
+  const double norm = world_from_body.rotation.norm();
+  if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
+    return Status::Error("orientation quaternion is not unit length (norm " + std::to_string(norm) +
+                         ")");
+  }
+  if (!IsFinite(linear_velocity)) {
+    return Status::Error("linear velocity is not finite: " + Describe(linear_velocity));
+  }
+  if (!IsFinite(angular_velocity)) {
+    return Status::Error("angular velocity is not finite: " + Describe(angular_velocity));
+  }
+  return Status::Ok();
+}
+
+// Sets (x, q, P, L) from the pose of the body frame and the twist of its
+// origin: v_com = v_origin + omega x (x_com - p_origin), P = M v_com,
+// L = I_world omega.
+void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
+                  const Vec3& angular_velocity, Body* body) {
+  const Pose world_from_principal = world_from_body * body->principal_from_body.Inverse();
+  body->position = world_from_principal.translation;
+  body->orientation = world_from_principal.rotation.normalized();
+  if (body->is_static) {
+    body->linear_momentum.setZero();
+    body->angular_momentum.setZero();
+  } else {
+    const Vec3 com_velocity =
+        linear_velocity + angular_velocity.cross(body->position - world_from_body.translation);
+    body->linear_momentum = body->mass * com_velocity;
+    const Mat3 rotation = body->orientation.toRotationMatrix();
+    const Vec3 principal_moments = body->inverse_principal_moments.cwiseInverse();
+    body->angular_momentum =
+        rotation * principal_moments.asDiagonal() * rotation.transpose() * angular_velocity;
+  }
+  body->force.setZero();
+  body->torque.setZero();
+  body->pseudo_linear_velocity.setZero();
+  body->pseudo_angular_velocity.setZero();
+  body->awake = true;
+  body->sleep_time = 0.0;
+  body->speeding_up_time = 0.0;
+  body->UpdateDerived();
+  body->start_linear_velocity = body->linear_velocity;
+  body->start_angular_momentum = body->angular_momentum;
+}
+
+namespace {
+
+// A pool of the threads `settings` ask for; out-of-range counts (refused by
+// ValidateWorldSettings, reaching here only with asserts off) clamp.
+std::unique_ptr<TaskPool> MakePool(const WorldSettings& settings) {
+  return std::make_unique<TaskPool>(
+      std::clamp(ResolveThreadCount(settings.threads), 1, kMaxThreads));
+}
+
+}  // namespace
+
+WorldImpl::WorldImpl(const WorldSettings& settings)
+    : settings_(settings), pool_(MakePool(settings)) {
+  assert(ValidateWorldSettings(settings).ok());
+  solver_.set_pool(pool_.get());
+}
+
+Status WorldImpl::SetSettings(const WorldSettings& settings) {
+  Status status = ValidateWorldSettings(settings);
+  if (!status.ok()) return status;
+  if (ResolveThreadCount(settings.threads) != pool_->threads()) {
+    pool_ = MakePool(settings);
+    solver_.set_pool(pool_.get());
+  }
+  settings_ = settings;
+  return status;
+}
+
+Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
+  if (Status status = ValidateState(def.world_from_body, def.linear_velocity, def.angular_velocity);
+      !status.ok()) {
+    return status;
+  }
+  for (std::size_t i = 0; i < def.shapes.size(); ++i) {
+    const ShapeDef& shape = def.shapes[i];
+    if (Status status = ValidateShapeDef(shape); !status.ok()) {
+      return Status::Error("shape " + std::to_string(i) + ": " + status.message());
+    }
+    if (std::holds_alternative<HalfSpace>(shape.geometry) &&
+        (!def.is_static || def.shapes.size() != 1)) {
+      return Status::Error("shape " + std::to_string(i) +
+                           ": a half-space must be the only shape of a static body");
+    }
+    if (std::holds_alternative<StaticMesh>(shape.geometry) && !def.is_static) {
+      return Status::Error("shape " + std::to_string(i) +
+                           ": a static triangle mesh needs a static body (is_static); a moving "
+                           "body's mesh must be a convex hull or convex pieces");
+    }
+  }
+  if (def.shapes.size() > kMaxShapesPerBody) {
+    return Status::Error("a body may have at most " + std::to_string(kMaxShapesPerBody) +
+                         " shapes, got " + std::to_string(def.shapes.size()));
+  }
+  if (body_count_ >= kMaxBodies) {
+    return Status::Error("the world is full: " + std::to_string(kMaxBodies) + " bodies");
+  }
+
+  Body body;
+  body.is_static = def.is_static;
+  body.user_data = def.user_data;
+  body.shapes = def.shapes;
+  AddMeshSlots(&body.shapes);
+  if (body.shapes.size() > kMaxShapesPerBody) {
+    return Status::Error("a body may have at most " + std::to_string(kMaxShapesPerBody) +
+                         " shapes, counting " + std::to_string(StaticMesh::kContactSlots) +
+                         " per static mesh, got " + std::to_string(body.shapes.size()));
+  }
+  if (!def.is_static) {
+    if (Status status = ValidateMassProperties(def.mass_properties); !status.ok()) {
+      return status;
+    }
+    const PrincipalAxes axes = ComputePrincipalAxes(def.mass_properties.inertia_about_com);
+    body.mass = def.mass_properties.mass;
+    body.inverse_mass = 1.0 / body.mass;
+    body.inverse_principal_moments = axes.principal_moments.cwiseInverse();
+    const Pose body_from_principal{def.mass_properties.center_of_mass, axes.body_from_principal};
+    body.principal_from_body = body_from_principal.Inverse();
+  }
+  SetBodyState(def.world_from_body, def.linear_velocity, def.angular_velocity, &body);
+  body.in_use = true;
+  body.thickness = std::numeric_limits<double>::infinity();
+  const Vec3 com_body = body.principal_from_body.Inverse().translation;
+  for (const ShapeDef& shape : body.shapes) {
+    // A half-space is unbounded; it is static, so its size never limits motion.
+    if (std::holds_alternative<HalfSpace>(shape.geometry)) continue;
+    body.thickness = std::min(body.thickness, ShapeThickness(shape.geometry));
+    body.bounding_radius =
+        std::max(body.bounding_radius,
+                 ShapeBoundingRadius(shape.geometry, shape.body_from_shape.Inverse() * com_body));
+  }
+
+  BodyId id;
+  if (free_slots_.empty()) {
+    id.index = static_cast<std::uint32_t>(bodies_.size());
+    bodies_.push_back(std::move(body));
+  } else {
+    id.index = free_slots_.back();
+    free_slots_.pop_back();
+    body.generation = bodies_[id.index].generation;
+    bodies_[id.index] = std::move(body);
+  }
+  id.generation = bodies_[id.index].generation;
+  ++body_count_;
+  RestartSleepWindow(id.index);
+  const Body& created = bodies_[id.index];
+  if (created.shapes.size() == 1 && std::holds_alternative<HalfSpace>(created.shapes[0].geometry)) {
+    half_space_bodies_.push_back(id.index);
+  }
+  return id;
+}
+
+Status WorldImpl::DestroyBody(BodyId id) {
+  if (!IsValid(id)) return Status::Error("no body with this id");
+  Body& body = bodies_[id.index];
+  if (body.articulation >= 0) {
+    return Status::Error("the body is a link of an articulation; destroy the articulation");
+  }
+  if (body.has_proxy) broad_phase_.RemoveProxy(static_cast<int>(id.index));
+  contact_cache_.RemoveBody(id.index);
+  half_space_bodies_.erase(
+      std::remove(half_space_bodies_.begin(), half_space_bodies_.end(), id.index),
+      half_space_bodies_.end());
+  WakeTouching(id.index);
+  const std::uint32_t next_generation = body.generation + 1;
+  body = Body();
+  body.generation = next_generation;
+  free_slots_.push_back(id.index);
+  --body_count_;
+  return Status::Ok();
+}
+
+bool WorldImpl::IsValid(BodyId id) const {
+  return id.index < bodies_.size() && bodies_[id.index].in_use &&
+         bodies_[id.index].generation == id.generation;
+}
+
+const Body& WorldImpl::GetBody(BodyId id) const {
+  assert(IsValid(id));
+  return bodies_[id.index];
+}
+
+Body& WorldImpl::MutableBody(BodyId id) {
+  assert(IsValid(id));
+  return bodies_[id.index];
+}
+
+Pose WorldImpl::GetPose(BodyId id) const { return GetBody(id).WorldFromBody(); }
+
+Vec3 WorldImpl::GetLinearVelocity(BodyId id) const {
+  const Body& body = GetBody(id);
+  return body.PointVelocity(body.WorldFromBody().translation);
+}
+
+Vec3 WorldImpl::GetAngularVelocity(BodyId id) const { return GetBody(id).angular_velocity; }
+
+Status WorldImpl::SetState(BodyId id, const Pose& world_from_body, const Vec3& linear_velocity,
+                           const Vec3& angular_velocity) {
+  if (!IsValid(id)) return Status::Error("no body with this id");
+  if (Status status = ValidateState(world_from_body, linear_velocity, angular_velocity);
+      !status.ok()) {
+    return status;
+  }
+  Body& body = MutableBody(id);
+  if (body.articulation >= 0) {
+    return MoveArticulation(static_cast<std::uint32_t>(body.articulation), world_from_body,
+                            linear_velocity, angular_velocity, body.link);
+  }
+  body.disabled = false;
+  SetBodyState(world_from_body, linear_velocity, angular_velocity, &body);
+  RestartSleepWindow(id.index);
+  // Teleported: last step's contacts and impulses no longer apply, and
+  // whatever rested on the body must notice that it left.
+  WakeTouching(id.index);
+  contact_cache_.RemoveBody(id.index);
+  if (body.is_static && body.has_proxy) {
+    broad_phase_.RemoveProxy(static_cast<int>(id.index));
+    body.has_proxy = false;
+  }
+  return Status::Ok();
+}
+
+Status WorldImpl::ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Vec3& point_world) {
+  if (!IsValid(id)) return Status::Error("no body with this id");
+  if (!IsFinite(force_world)) return Status::Error("force is not finite: " + Describe(force_world));
+  if (!IsFinite(point_world)) return Status::Error("point is not finite: " + Describe(point_world));
+  Body& body = MutableBody(id);
+  if (body.is_static) return Status::Ok();
+  Wake(id.index);
+  body.force += force_world;
+  body.torque += (point_world - body.position).cross(force_world);
+  return Status::Ok();
+}
+
+Status WorldImpl::ApplyTorque(BodyId id, const Vec3& torque_world) {
+  if (!IsValid(id)) return Status::Error("no body with this id");
+  if (!IsFinite(torque_world)) {
+    return Status::Error("torque is not finite: " + Describe(torque_world));
+  }
+  Body& body = MutableBody(id);
+  if (body.is_static) return Status::Ok();
+  Wake(id.index);
+  body.torque += torque_world;
+  return Status::Ok();
+}
+
+void WorldImpl::Restart() {
+  time_ = 0.0;
+  contacts_.clear();
+  collision_log_.clear();
+  contact_cache_.Clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_[i].in_use && !bodies_[i].is_static) Wake(i);
+  }
+}
+
+std::size_t WorldImpl::AwakeBodyCount() const {
+  std::size_t count = 0;
+  for (const Body& body : bodies_) count += body.in_use && !body.is_static && body.awake;
+  return count;
+}
+
+void WorldImpl::Wake(std::uint32_t index) {
+  Body& body = bodies_[index];
+  if (body.disabled) return;
+  woke_since_prune_ |= !body.awake;
+  body.awake = true;
+  body.sleep_time = 0.0;
+  body.speeding_up_time = 0.0;
+  RestartSleepWindow(index);
+}
+
+void WorldImpl::RestartSleepWindow(std::uint32_t index) {
+  if (index < sleep_windows_.size()) sleep_windows_[index] = SleepWindow{};
+}
+
+void WorldImpl::WakeTouching(std::uint32_t index) {
+  for (const ContactReport& contact : contacts_) {
+    if (contact.body_a.index != index && contact.body_b.index != index) continue;
+    for (const BodyId other : {contact.body_a, contact.body_b}) {
+      if (other.index != index && IsValid(other) && !bodies_[other.index].is_static) {
+        Wake(other.index);
+      }
+    }
+  }
+}
+
+std::vector<ContactReport> WorldImpl::TakeCollisionLog() {
+  std::vector<ContactReport> log;
+  log.swap(collision_log_);
+  return log;
+}
+
+void WorldImpl::Step() {
+  const double dt = settings_.time_step;
+  non_finite_bodies_.clear();
+  // Wall time since the previous lap, ms; steady_clock costs tens of
+  // nanoseconds a read, nothing next to a stage.
+  std::chrono::steady_clock::time_point lap_start = std::chrono::steady_clock::now();
+  auto lap = [&lap_start]() {
+    const std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - lap_start).count();
+    lap_start = now;
+    return ms;
+  };
+  StepProfile& profile = last_step_profile_;
+
+  GuardBeforeStep(dt);
+  UpdateBroadPhase(dt);
+  profile.broad_phase_ms = lap();
+  UpdateNarrowPhase(dt);
+  profile.narrow_phase_ms = lap();
+  UpdateContactCache();
+  profile.contact_cache_ms = lap();
+  SolveContacts(dt);
+  profile.solver_ms = lap();
+  IntegrateBodies(dt);
+  profile.integrator_ms = lap();
+  GuardAfterStep();
+
+  profile.solver_points = 0;
+  for (const SolverManifold& manifold : solver_.manifolds()) {
+    profile.solver_points += static_cast<std::size_t>(manifold.point_count);
+  }
+  profile.velocity_sweeps = solver_.velocity_sweeps();
+  profile.velocity_row_updates = solver_.velocity_row_updates();
+  profile.island_groups = solver_.island_groups();
+  time_ += dt;
+}
+
+}  // namespace rigid_body_sim::physics

@@ -1,0 +1,255 @@
+// The implementation behind World (world.h), which forwards every call here,
+// so that the public header shows none of the stages' state. Its methods are
+// defined in world_impl.cc (bodies and state) and in one file per stage of
+// Step (step_*.cc).
+#ifndef RIGID_BODY_SIM_PHYSICS_WORLD_WORLD_IMPL_H_
+#define RIGID_BODY_SIM_PHYSICS_WORLD_WORLD_IMPL_H_
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "physics/articulation/articulation_dynamics.h"
+#include "physics/articulation/articulation_solver.h"
+#include "physics/collision/broad_phase.h"
+#include "physics/contact/contact_cache.h"
+#include "physics/solver/contact_solver.h"
+#include "physics/dynamics/integrator.h"
+#include "physics/dynamics/sleep_window.h"
+#include "physics/world/task_pool.h"
+#include "rigid_body_sim/physics/articulation.h"
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/result.h"
+#include "rigid_body_sim/physics/types.h"
+#include "rigid_body_sim/physics/world_settings.h"
+
+namespace rigid_body_sim::physics {
+
+// A pair that comes into contact within a (sub)step, and when.
+struct Impact {
+  ShapePairContact* pair = nullptr;
+  double time = 0.0;       // s from the (sub)step's start
+  bool colliding = false;  // the surfaces meet faster than collision_velocity_threshold
+};
+
+// A shape pair the narrow phase tests this step (stage 2): its cache entry,
+// which holds the bodies, shapes and contact distance, and the summed travel
+// of the two bodies (Body::travel). Jobs write only their own entry, so any
+// thread may run any of them.
+struct NarrowJob {
+  ShapePairContact* entry = nullptr;
+  double travel = 0.0;  // m
+  bool reused = false;  // the manifold was carried, not clipped (out)
+};
+
+// Refuses a non-finite pose or velocity, or a quaternion not of unit length.
+Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
+                     const Vec3& angular_velocity);
+
+// Sets a body's state (x, q, P, L) from the pose of its body frame and the
+// twist of that frame's origin, and restarts its sleep and step records.
+void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
+                  const Vec3& angular_velocity, Body* body);
+
+// An articulation in the world: its model, its state, and the state its
+// constraint solve chose for the end of the step.
+// One joint row before it has a solver slot: the row on its dof `column`
+// (sign: +1 pushes the joint forward), as ConstraintRow's fields.
+struct JointRowSpec {
+  int joint = -1;
+  int column = 0;
+  double sign = 1.0;
+  RowKind kind = RowKind::kBounded;
+  double target = 0.0;  // velocity units of the row
+  double bound = 0.0;   // |impulse| <= bound (kBounded)
+  double softness = 0.0;
+};
+
+struct ArticulationEntry {
+  ArticulationModel model;
+  ArticulationState state;
+  ArticulationState next;
+  ServoGains gains;
+  FreeMotionSplit free_motion_split;
+  bool in_use = false;
+  std::uint32_t generation = 0;
+};
+
+// The public methods do what World's of the same name are documented to do.
+class WorldImpl {
+ public:
+  explicit WorldImpl(const WorldSettings& settings);
+
+  const WorldSettings& settings() const { return settings_; }
+  Status SetSettings(const WorldSettings& settings);
+  Result<BodyId> CreateBody(const BodyDef& def);
+  Status DestroyBody(BodyId id);
+  bool IsValid(BodyId id) const;
+  std::size_t BodyCount() const { return body_count_; }
+  std::size_t AwakeBodyCount() const;
+  Pose GetPose(BodyId id) const;
+  Vec3 GetLinearVelocity(BodyId id) const;
+  Vec3 GetAngularVelocity(BodyId id) const;
+  Status SetState(BodyId id, const Pose& world_from_body, const Vec3& linear_velocity,
+                  const Vec3& angular_velocity);
+  const Body& GetBody(BodyId id) const;
+  Status ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Vec3& point_world);
+  Status ApplyTorque(BodyId id, const Vec3& torque_world);
+  void Step();
+  std::vector<BodyOverlap> FindOverlaps(BodyId id) const;  // world_queries.cc
+  double time() const { return time_; }
+  const StepProfile& last_step_profile() const { return last_step_profile_; }
+  void Restart();
+  const std::vector<BodyId>& non_finite_bodies() const { return non_finite_bodies_; }
+  const std::vector<ContactReport>& contacts() const { return contacts_; }
+  std::vector<ContactReport> TakeCollisionLog();
+
+  // Articulations (world_articulations.cc).
+  Result<ArticulationId> CreateArticulation(const ArticulationDef& def);
+  Status DestroyArticulation(ArticulationId id);
+  bool IsValid(ArticulationId id) const;
+  std::vector<BodyId> ArticulationLinks(ArticulationId id) const;
+  std::vector<JointState> GetJointStates(ArticulationId id) const;
+  Status SetJointStates(ArticulationId id, const std::vector<double>& positions,
+                        const std::vector<double>& velocities);
+  Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command);
+  Status SetServoGains(ArticulationId id, const ServoGains& gains);
+
+ private:
+  Body& MutableBody(BodyId id);
+  BodyId BodyIdOf(std::uint32_t index) const;
+  void Wake(std::uint32_t body);
+  // Starts the body's sleep window again (it woke, was created or moved).
+  void RestartSleepWindow(std::uint32_t body);
+  // Wakes every body that touched `body` in the last step.
+  void WakeTouching(std::uint32_t body);
+
+  // The stages of Step, in order, one file each (step_*.cc).
+  void UpdateBroadPhase(double dt);   // 1. broad phase: swept boxes, candidate pairs
+  void UpdateNarrowPhase(double dt);  // 2. narrow phase: manifolds per shape pair
+  void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
+  void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
+  // Stage 4's parts (step_solver.cc).
+  void SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs);
+  void HoldPushedBodies();
+  void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
+  void ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt, bool impacts_only);
+  void ReportSleepingContacts(double dt);
+  void IntegrateBodies(double dt);  // 5. integrator: drift, time of impact, sleep
+  // Stage 5's parts (step_integrator.cc, step_impacts.cc).
+  void CapSpin(double dt);
+  void DriftBodies(double dt);
+  void BoundBodyMotion(double dt);
+  std::vector<Impact> FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs);
+  // Time of impact within dt, or +infinity; with the speed the surfaces
+  // meet at, m/s.
+  double PairImpactTime(double dt, ShapePairContact* pair, double* approach_speed);
+  void ResolveImpacts(double h, const std::vector<Impact>& impacts,
+                      const std::vector<ShapePairContact*>& touching, int round);
+  void BackUpBody(std::uint32_t index, double time);
+  void SubStep(const std::vector<std::uint32_t>& island, double h, int round);
+  void RecollidePair(double h, ShapePairContact* pair);
+  int PathSamples(std::uint32_t body_a, std::uint32_t body_b) const;
+  double PairThickness(const ShapePairContact& pair) const;
+  // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
+  // a static mesh's are tested at once.
+  void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  // Tests one listed shape pair: carries its manifold or clips a new one.
+  void CollideShapePair(NarrowJob* job) const;
+  double ContactDistance(const Body& a, const Body& b, double dt) const;
+  double ContactReach(const Body& a, const Body& b, double dt) const;
+  bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
+                     const Pose& world_from_shape_b, ShapePairContact* entry) const;
+  void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
+                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
+  void UpdateSleep(double dt);
+  bool UpdateSpeedingUp(double dt, Body* body) const;
+  void DisableNonFiniteBodies();
+  void DisableBody(std::uint32_t index);
+  // The step guard (step_guard.cc), around stages 1-5: bodies whose state
+  // or pending force would overflow a step are frozen before it, bodies
+  // whose state is not finite after it go back to their pose at its start.
+  void GuardBeforeStep(double dt);
+  void GuardAfterStep();
+  void FreezeBody(std::uint32_t index, const Pose& world_from_principal);
+  // `pairs` are the touching pairs, one per solver manifold.
+  void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt);
+  ContactReport MakeReport(const ShapePairContact& pair, int point,
+                           const std::array<Vec3, 2>& tangent, double dt) const;
+
+  // Articulations (world_articulations.cc, step_articulations.cc).
+  Status MoveArticulation(std::uint32_t index, const Pose& world_from_link,
+                          const Vec3& linear_velocity, const Vec3& angular_velocity, int link);
+  void PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart);
+  bool SkipsPair(const Body& a, const Body& b) const;
+  // Splits the touching pairs into those of rigid bodies only (the contact
+  // solver's) and those with a link (the articulation solve's).
+  void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
+  void SolveArticulations(double dt);
+  void AddArticulationRows(std::uint32_t index, int slot, const std::vector<JointRowSpec>& rows);
+  void CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation);
+  void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
+  void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
+                          const std::vector<ArticulationKinematics>& kinematics);
+  void ReportLinkContacts(double dt);
+  void MoveArticulations(double dt);
+
+  WorldSettings settings_;
+  std::unique_ptr<TaskPool> pool_;      // settings_.threads threads
+  std::vector<NarrowJob> narrow_jobs_;  // stage 2's, in the order the pairs were visited
+  // FindImpacts' per pair: the time of impact (s, +infinity for none) and
+  // the speed the surfaces meet at (m/s).
+  struct ImpactSearch {
+    double time = 0.0;
+    double approach_speed = 0.0;
+  };
+  std::vector<ImpactSearch> impact_searches_;
+  std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
+  std::vector<std::uint32_t> free_slots_;
+  std::size_t body_count_ = 0;
+  double time_ = 0.0;
+  std::uint64_t step_count_ = 0;
+  SortAndSweepBroadPhase broad_phase_;
+  std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
+  ContactCache contact_cache_;
+  bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3
+  // contacts_ begins with the reports of the sleeping pairs, made when
+  // their list last changed (its version is kept here).
+  std::uint64_t sleeping_reports_version_ = ~std::uint64_t{0};
+  std::size_t sleeping_report_count_ = 0;
+  ContactSolver solver_;
+  std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
+  std::vector<Vec3> push_normals_;            // HoldPushedBodies' scratch, per body slot
+  std::vector<std::uint8_t> push_state_;      // 0 not pushed, 1 along one normal, 2 several
+  std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
+  std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
+  std::vector<SleepWindow> sleep_windows_;    // the sleep test's, per body slot (UpdateSleep)
+  std::vector<ContactReport> contacts_;
+  std::vector<ContactReport> collision_log_;
+  std::vector<BodyId> non_finite_bodies_;
+  std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
+  StepProfile last_step_profile_;
+  std::vector<ArticulationEntry> articulations_;
+  ArticulationSolver articulation_solver_;
+  ArticulatedBodyScratch articulation_scratch_;  // SolveArticulations'
+  std::vector<ShapePairContact*> rigid_pairs_;   // SplitLinkPairs'
+  std::vector<ShapePairContact*> link_pairs_;
+  // Per link pair, the index of its first normal row, or -1.
+  std::vector<int> link_pair_rows_;
+  // The normal rows of link contacts penetrating beyond the slop, each with
+  // the speed that removes position_correction of that depth in one step,
+  // and the solver of their split impulse (CorrectLinkPenetration).
+  std::vector<std::pair<int, double>> link_penetrations_;
+  std::vector<std::size_t> link_bouncing_rows_;  // scratch of BounceLinkContacts
+  // The rigid bodies' velocities of the link solve before its restitution
+  // pass, per body slot; empty when no point bounced this step.
+  std::vector<ArticulationSolver::BodySlot> link_solved_bodies_;
+  ArticulationSolver link_pseudo_solver_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_WORLD_WORLD_IMPL_H_
