@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
-#include "support/gjk.h"
 #include "physics/collision/narrow_phase.h"
 #include "scene.h"
+#include "support/gjk.h"
 
 namespace rigid_body_sim::physics {
 namespace {

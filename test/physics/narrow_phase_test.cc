@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
-#include "support/gjk.h"
 #include "physics/collision/polyhedron_collision.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
+#include "support/gjk.h"
 
 namespace rigid_body_sim::physics {
 namespace {

@@ -2,9 +2,9 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_COLLISION_NARROW_PHASE_H_
 #define RIGID_BODY_SIM_PHYSICS_COLLISION_NARROW_PHASE_H_
 
-#include "physics/contact/contact_manifold.h"
 #include "physics/collision/cylinder_collision.h"
 #include "physics/collision/polyhedron_collision.h"
+#include "physics/contact/contact_manifold.h"
 #include "rigid_body_sim/physics/shape.h"
 #include "rigid_body_sim/physics/types.h"
 

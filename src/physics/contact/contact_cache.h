@@ -17,8 +17,8 @@
 #include <utility>
 #include <vector>
 
-#include "physics/contact/contact_manifold.h"
 #include "physics/collision/pair_index.h"
+#include "physics/contact/contact_manifold.h"
 
 namespace rigid_body_sim::physics {
 

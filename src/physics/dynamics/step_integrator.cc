@@ -5,8 +5,8 @@
 #include <limits>
 #include <variant>
 
-#include "physics/dynamics/integrator.h"
 #include "physics/collision/narrow_phase.h"
+#include "physics/dynamics/integrator.h"
 #include "physics/geometry/shape_bounds.h"
 #include "physics/world/union_find.h"
 #include "physics/world/world_impl.h"

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "physics/dynamics/integrator.h"
 #include "physics/collision/mesh_collision.h"
+#include "physics/dynamics/integrator.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {

@@ -5,8 +5,8 @@
 #include <variant>
 #include <vector>
 
-#include "physics/geometry/aabb.h"
 #include "physics/collision/narrow_phase.h"
+#include "physics/geometry/aabb.h"
 #include "physics/geometry/shape_bounds.h"
 #include "physics/world/world_impl.h"
 
