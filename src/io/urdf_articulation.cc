@@ -27,6 +27,41 @@ JointType TypeOf(const std::string& urdf_type) {
   return JointType::kRevolute;
 }
 
+// A movable joint's own fields; its links and frame are the caller's.
+JointDef JointDefOf(const JointInfo& joint) {
+  JointDef def;
+  def.name = joint.name;
+  def.type = TypeOf(joint.type);
+  def.axis = joint.axis;
+  def.lower = joint.lower;
+  def.upper = joint.upper;
+  def.effort_limit = joint.effort;
+  def.velocity_limit = joint.velocity;
+  def.damping = joint.damping;
+  def.friction = joint.friction;
+  def.position = joint.position;
+  def.mimic_multiplier = joint.mimic_multiplier;
+  def.mimic_offset = joint.mimic_offset;
+  return def;
+}
+
+// The mass of one articulation link (a group of URDF links joined by fixed
+// joints): its parts combined, or the placeholder when it has none (with a
+// warning, unless it is the base, whose mass a fixed base never uses).
+MassProperties GroupMass(const std::vector<MassProperties>& parts, const std::string& root_name,
+                         bool is_base, std::vector<std::string>* warnings) {
+  if (!parts.empty()) return physics::CombineMassProperties(parts);
+  if (!is_base) {
+    warnings->push_back("link '" + root_name +
+                        "' and the links fixed to it have no mass; it moves as " +
+                        physics::FormatNumber(kPlaceholderMass) + " kg");
+  }
+  MassProperties placeholder;
+  placeholder.mass = kPlaceholderMass;
+  placeholder.inertia_about_com = physics::Mat3::Identity() * kPlaceholderInertia;
+  return placeholder;
+}
+
 }  // namespace
 
 Result<ArticulationDef> MakeArticulationDef(const LoadedModel& model,
@@ -52,23 +87,11 @@ Result<ArticulationDef> MakeArticulationDef(const LoadedModel& model,
     // joint's <origin>.
     const Pose root_from_parent_group = frame_of_link.at(group_root[parent_group])->root_from_link;
     const Pose root_from_parent = frame_of_link.at(joint.parent_link)->root_from_link;
-    JointDef& def_joint = def.joints.emplace_back();
-    def_joint.name = joint.name;
-    def_joint.type = TypeOf(joint.type);
+    JointDef& def_joint = def.joints.emplace_back(JointDefOf(joint));
     def_joint.parent_link = parent_group;
     def_joint.child_link = child_group;
     def_joint.parent_from_joint =
         root_from_parent_group.Inverse() * root_from_parent * joint.parent_from_joint;
-    def_joint.axis = joint.axis;
-    def_joint.lower = joint.lower;
-    def_joint.upper = joint.upper;
-    def_joint.effort_limit = joint.effort;
-    def_joint.velocity_limit = joint.velocity;
-    def_joint.damping = joint.damping;
-    def_joint.friction = joint.friction;
-    def_joint.position = joint.position;
-    def_joint.mimic_multiplier = joint.mimic_multiplier;
-    def_joint.mimic_offset = joint.mimic_offset;
     joint_index[joint.name] = static_cast<int>(def.joints.size()) - 1;
   }
   // Leaders may come after their mimics in tree order: linked once all are
@@ -103,19 +126,7 @@ Result<ArticulationDef> MakeArticulationDef(const LoadedModel& model,
                         "the articulation's base is fixed where it is spawned");
   }
   for (std::size_t g = 0; g < group_root.size(); ++g) {
-    if (parts[g].empty()) {
-      // A fixed base's mass is never used; the placeholder keeps it valid.
-      if (g != 0) {
-        warnings->push_back("link '" + group_root[g] +
-                            "' and the links fixed to it have no mass; it moves as " +
-                            physics::FormatNumber(kPlaceholderMass) + " kg");
-      }
-      def.links[g].mass_properties.mass = kPlaceholderMass;
-      def.links[g].mass_properties.inertia_about_com =
-          physics::Mat3::Identity() * kPlaceholderInertia;
-      continue;
-    }
-    def.links[g].mass_properties = physics::CombineMassProperties(parts[g]);
+    def.links[g].mass_properties = GroupMass(parts[g], group_root[g], g == 0, warnings);
   }
   def.world_from_base = model.world_from_root;
   return def;

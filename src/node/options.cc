@@ -1,6 +1,7 @@
 #include "rigid_body_sim/node/options.h"
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <type_traits>
@@ -248,46 +249,57 @@ std::vector<std::string> LiveSettingsWarnings(const LiveSettings& settings,
 
 namespace {
 
-// The size and process limits, and the joint servo's gains.
-Status ValidateLimitOptions(const NodeOptions& options) {
-  // The articulation holds at most 1000 links (physics/world_articulations.cc).
-  const struct {
-    const char* name;
-    double value;
-    double low;
-    double high;
-    const char* unit;
-  } kRanges[] = {
-      {"~max_links_per_model", static_cast<double>(options.max_links_per_model), 1, 1e9, ""},
-      {"~max_joints_per_model", static_cast<double>(options.max_joints_per_model), 1, 999, ""},
-      {"~max_mesh_triangles", static_cast<double>(options.max_mesh_triangles), 1,
-       static_cast<double>(physics::CollisionMesh::kMaxTriangles), ""},
-      {"~max_file_bytes", static_cast<double>(options.max_file_bytes), 1, 2147483647.0, "bytes"},
-      {"~mesh_memory_limit", static_cast<double>(options.mesh_memory_limit), 16777216.0,
-       2147483647.0, "bytes"},
-  };
-  for (const auto& range : kRanges) {
-    if (Status status = CheckRange(range.name, range.value, range.low, range.high, range.unit);
-        !status.ok()) {
-      return status;
-    }
-  }
+// One scalar parameter's allowed range, with its unit; an open end
+// excludes its bound.
+struct ParamRange {
+  const char* name;
+  double value;
+  double low;
+  double high;
+  const char* unit;
+  bool low_open = false;
+  bool high_open = false;
+};
+
+Status CheckParamRange(const ParamRange& range) {
+  const bool above_low = range.low_open ? range.value > range.low : range.value >= range.low;
+  const bool below_high = range.high_open ? range.value < range.high : range.value <= range.high;
+  if (above_low && below_high) return Status::Ok();  // false for NaN
+  const std::string unit = *range.unit == '\0' ? "" : std::string(" ") + range.unit;
+  return Status::Error(std::string(range.name) + " " + FormatNumber(range.value) + unit +
+                       " is outside the allowed range " + (range.low_open ? "(" : "[") +
+                       FormatNumber(range.low) + ", " + FormatNumber(range.high) +
+                       (range.high_open ? ")" : "]") + unit);
+}
+
+// The node's own scalar parameters and their ranges, in the order they are
+// checked; the world's settings are checked by physics::ValidateWorldSettings,
+// the live ones by ValidateLiveSettings.
+std::vector<ParamRange> NodeParamRanges(const NodeOptions& options) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
   // The servo is implicit, so any gain is stable; the bound keeps dt k
   // (and so the soft row's terms) far from overflow.
   constexpr double kMaxServoGain = 1e12;
-  if (!(options.servo.stiffness > 0.0 && options.servo.stiffness <= kMaxServoGain)) {
-    return Status::Error("~joint_stiffness " + FormatNumber(options.servo.stiffness) +
-                         " is outside the allowed range (0, 1e12] N m/rad");
-  }
-  if (!(options.servo.damping >= 0.0 && options.servo.damping <= kMaxServoGain)) {
-    return Status::Error("~joint_damping " + FormatNumber(options.servo.damping) +
-                         " is outside the allowed range [0, 1e12] N m s/rad");
-  }
-  if (!(options.mesh_cpu_limit > 0.0 && options.mesh_cpu_limit <= 3600.0)) {
-    return Status::Error("~mesh_cpu_limit " + FormatNumber(options.mesh_cpu_limit) +
-                         " s is outside the allowed range (0, 3600] s");
-  }
-  return Status::Ok();
+  auto count = [](auto value) { return static_cast<double>(value); };
+  return {
+      {"~max_links_per_model", count(options.max_links_per_model), 1, 1e9, ""},
+      // The articulation holds at most 1000 links (world_articulations.cc).
+      {"~max_joints_per_model", count(options.max_joints_per_model), 1, 999, ""},
+      {"~max_mesh_triangles", count(options.max_mesh_triangles), 1,
+       count(physics::CollisionMesh::kMaxTriangles), ""},
+      {"~max_file_bytes", count(options.max_file_bytes), 1, 2147483647.0, "bytes"},
+      {"~mesh_memory_limit", count(options.mesh_memory_limit), 16777216.0, 2147483647.0, "bytes"},
+      {"~joint_stiffness", options.servo.stiffness, 0, kMaxServoGain, "N m/rad", true},
+      {"~joint_damping", options.servo.damping, 0, kMaxServoGain, "N m s/rad"},
+      {"~mesh_cpu_limit", options.mesh_cpu_limit, 0, 3600, "s", true},
+      {"~threads", count(options.world.threads), 0, count(physics::kMaxThreads), ""},
+      {"~ground_friction", options.ground_friction, 0, kInfinity, "", false, true},
+      {"~ground_restitution", options.ground_restitution, 0, 1, ""},
+      {"~default_density", options.default_density, 0, kInfinity, "kg/m^3", true, true},
+      {"~max_hull_vertices", count(options.max_hull_vertices), 4, kInfinity, "", false, true},
+      {"~status_period", options.status_period, 0, kInfinity, "s", true, true},
+      {"~contact_force_scale", options.contact_force_scale, 0, kInfinity, "m/N", true, true},
+  };
 }
 
 }  // namespace
@@ -305,10 +317,8 @@ Status ValidateNodeOptions(const NodeOptions& options) {
         ValidateRequestLimits(options.limits)}) {
     if (!status.ok()) return status;
   }
-  if (Status status = ValidateLimitOptions(options); !status.ok()) return status;
-  if (Status status = CheckRange("~threads", options.world.threads, 0, physics::kMaxThreads, "");
-      !status.ok()) {
-    return status;
+  for (const ParamRange& range : NodeParamRanges(options)) {
+    if (Status status = CheckParamRange(range); !status.ok()) return status;
   }
   if (Status status = physics::ValidateWorldSettings(options.world); !status.ok()) {
     return Status::Error(
@@ -318,37 +328,6 @@ Status ValidateNodeOptions(const NodeOptions& options) {
   }
   if (Status status = ValidateLiveSettings(LiveSettingsOf(options), "~"); !status.ok()) {
     return status;
-  }
-  const auto check_friction = [](double value, const std::string& name) {
-    return value >= 0.0 && std::isfinite(value)
-               ? Status::Ok()
-               : Status::Error(name + " " + FormatNumber(value) + " must be >= 0");
-  };
-  const auto check_restitution = [](double value, const std::string& name) {
-    return value >= 0.0 && value <= 1.0
-               ? Status::Ok()
-               : Status::Error(name + " " + FormatNumber(value) + " must be in [0, 1]");
-  };
-  for (const Status& status :
-       {check_friction(options.ground_friction, "~ground_friction"),
-        check_restitution(options.ground_restitution, "~ground_restitution")}) {
-    if (!status.ok()) return status;
-  }
-  if (!(options.default_density > 0.0) || !std::isfinite(options.default_density)) {
-    return Status::Error("~default_density " + FormatNumber(options.default_density) +
-                         " kg/m^3 must be positive");
-  }
-  if (options.max_hull_vertices < 4) {
-    return Status::Error("~max_hull_vertices " + std::to_string(options.max_hull_vertices) +
-                         " must be >= 4");
-  }
-  if (!(options.status_period > 0.0) || !std::isfinite(options.status_period)) {
-    return Status::Error("~status_period " + FormatNumber(options.status_period) +
-                         " s must be positive");
-  }
-  if (!(options.contact_force_scale > 0.0) || !std::isfinite(options.contact_force_scale)) {
-    return Status::Error("~contact_force_scale " + FormatNumber(options.contact_force_scale) +
-                         " m/N must be positive");
   }
   std::set<std::string> model_names;
   for (const ModelSpec& spec : options.models) {

@@ -22,23 +22,26 @@ TEST(OptionsTest, BadValuesAreNamed) {
   EXPECT_NE(ValidateNodeOptions(options).message().find("~real_time_factor"), std::string::npos);
   options = NodeOptions();
   options.ground_restitution = 1.5;
-  EXPECT_EQ(ValidateNodeOptions(options).message(), "~ground_restitution 1.5 must be in [0, 1]");
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~ground_restitution 1.5 is outside the allowed range [0, 1]");
   options = NodeOptions();
   options.world_frame = "/world";
   EXPECT_NE(ValidateNodeOptions(options).message().find("leading slash"), std::string::npos);
   options = NodeOptions();
   options.servo.stiffness = 0.0;
   EXPECT_EQ(ValidateNodeOptions(options).message(),
-            "~joint_stiffness 0 is outside the allowed range (0, 1e12] N m/rad");
+            "~joint_stiffness 0 N m/rad is outside the allowed range (0, 1e+12] N m/rad");
   options = NodeOptions();
   options.servo.damping = -1.0;
   EXPECT_EQ(ValidateNodeOptions(options).message(),
-            "~joint_damping -1 is outside the allowed range [0, 1e12] N m s/rad");
+            "~joint_damping -1 N m s/rad is outside the allowed range [0, 1e+12] N m s/rad");
   options = NodeOptions();
   options.world.threads = -1;
-  EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads -1 is outside [0, 256]");
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~threads -1 is outside the allowed range [0, 256]");
   options.world.threads = 257;
-  EXPECT_EQ(ValidateNodeOptions(options).message(), "~threads 257 is outside [0, 256]");
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~threads 257 is outside the allowed range [0, 256]");
   options = NodeOptions();
   options.world.max_turn_per_step = 4.0;
   EXPECT_NE(

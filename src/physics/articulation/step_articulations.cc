@@ -170,7 +170,7 @@ void WorldImpl::AddArticulationRows(std::uint32_t index, int slot,
 // (a limit reached, a servo, friction, a contact) or stiff damping builds
 // its joint-space inertia M for the row solve, and only one with contacts
 // its links' Jacobians; the others take the free RK4 step.
-void WorldImpl::SolveArticulations(double dt) {
+void WorldImpl::SolveArticulations(const StepContext& step) {
   if (articulations_.empty()) return;
   articulation_solver_.Reset();
   std::vector<char> touched(articulations_.size(), 0);
@@ -181,63 +181,78 @@ void WorldImpl::SolveArticulations(double dt) {
   }
   std::vector<int> slot(articulations_.size(), -1);
   std::vector<ArticulationKinematics> kinematics(articulations_.size());
-  std::vector<JointRowSpec> joint_rows;
-  Eigen::VectorXd acceleration;
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
-    ArticulationEntry& entry = articulations_[i];
-    if (!entry.in_use) continue;
-    ArticulationModel& model = entry.model;
-    for (ArticulationLink& link : model.links) {
-      link.force = bodies_[link.body].force;
-      link.torque = bodies_[link.body].torque;
-    }
-    const Eigen::VectorXd efforts = CommandedEfforts(model);
-    ArticulationKinematics& k = kinematics[i];
-    ComputeKinematics(
-        model, entry.state, &k,
-        touched[i] ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
-    ForwardDynamics({model, entry.state, k, settings_.gravity, efforts, dt}, &articulation_scratch_,
-                    &acceleration);
-    const Eigen::VectorXd u_free = entry.state.u + dt * acceleration;
-    JointRowsOf(entry, u_free, dt, entry.gains, &joint_rows);
-    for (ArticulationJoint& joint : model.joints) {
-      joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
-    }
-    if (joint_rows.empty() && !touched[i] && !DampingIsStiff(model, k, dt)) {
-      // Without damping, u* came from the explicit dynamics: the first
-      // RK4 stage's u'.
-      const bool damped = AnyJointDamped(model);
-      entry.next = StepFreeMotionBalanced(
-          {model, entry.state, settings_.gravity, efforts, dt, damped ? nullptr : &acceleration},
-          &entry.free_motion_split);
-      continue;
-    }
-    Eigen::MatrixXd mass;
-    JointSpaceInertia(model, k, &mass);
-    for (const ArticulationJoint& joint : model.joints) {
-      if (joint.dof >= 0)
-        mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += dt * joint.def.damping;
-    }
-    slot[i] = articulation_solver_.AddArticulation(u_free, mass);
-    AddArticulationRows(i, slot[i], joint_rows);
+    if (!articulations_[i].in_use) continue;
+    slot[i] = SetUpArticulation(step, i, touched[i] != 0, &kinematics[i]);
   }
-  AddLinkContactRows(dt, slot, kinematics);
+  AddLinkContactRows(step, slot, kinematics);
   articulation_solver_.Solve(kMaxSweeps, kSweepTolerance);
 
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     if (slot[i] < 0) continue;
     ArticulationEntry& entry = articulations_[i];
     entry.next =
-        Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, dt);
+        Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, step.dt);
   }
   BounceLinkContacts(slot);
-  CorrectLinkPenetration(dt, slot);
+  CorrectLinkPenetration(step, slot);
+  RecordJointEfforts(step);
+  TakeLinkSolveVelocities();
+}
+
+// Articulation `index`'s free motion, u* = u + dt u' by the ABA. Without
+// rows, contacts or stiff damping it takes its free RK4 step at once (and
+// gets no solver slot, -1); otherwise it joins the row solve with M + dt B
+// and its joint rows, and its solver slot is returned.
+int WorldImpl::SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
+                                 ArticulationKinematics* kinematics) {
+  ArticulationEntry& entry = articulations_[index];
+  ArticulationModel& model = entry.model;
+  std::vector<JointRowSpec>& joint_rows = joint_row_scratch_;
+  Eigen::VectorXd& acceleration = acceleration_scratch_;
+  for (ArticulationLink& link : model.links) {
+    link.force = bodies_[link.body].force;
+    link.torque = bodies_[link.body].torque;
+  }
+  const Eigen::VectorXd efforts = CommandedEfforts(model);
+  ArticulationKinematics& k = *kinematics;
+  ComputeKinematics(
+      model, entry.state, &k,
+      touched ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
+  ForwardDynamics({model, entry.state, k, settings_.gravity, efforts, step.dt},
+                  &articulation_scratch_, &acceleration);
+  const Eigen::VectorXd u_free = entry.state.u + step.dt * acceleration;
+  JointRowsOf(entry, u_free, step.dt, entry.gains, &joint_rows);
+  for (ArticulationJoint& joint : model.joints) {
+    joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
+  }
+  if (joint_rows.empty() && !touched && !DampingIsStiff(model, k, step.dt)) {
+    // Without damping, u* came from the explicit dynamics: the first
+    // RK4 stage's u'.
+    const bool damped = AnyJointDamped(model);
+    entry.next = StepFreeMotionBalanced(
+        {model, entry.state, settings_.gravity, efforts, step.dt, damped ? nullptr : &acceleration},
+        &entry.free_motion_split);
+    return -1;
+  }
+  Eigen::MatrixXd mass;
+  JointSpaceInertia(model, k, &mass);
+  for (const ArticulationJoint& joint : model.joints) {
+    if (joint.dof >= 0)
+      mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += step.dt * joint.def.damping;
+  }
+  const int slot = articulation_solver_.AddArticulation(u_free, mass);
+  AddArticulationRows(index, slot, joint_rows);
+  return slot;
+}
+
+void WorldImpl::RecordJointEfforts(const StepContext& step) {
   // A joint's effort: its command's, its rows' impulses over dt, less its
   // damping; shared with its mimics, each taking its multiplier's part.
   for (const ConstraintRow& row : articulation_solver_.rows()) {
     if (row.joint < 0) continue;
     ArticulationEntry& entry = articulations_[row.articulation];
-    entry.model.joints[row.joint].effort += row.joint_sign * row.impulse / dt;
+    entry.model.joints[row.joint].effort += row.joint_sign * row.impulse / step.dt;
   }
   for (ArticulationEntry& entry : articulations_) {
     if (!entry.in_use) continue;
@@ -251,6 +266,10 @@ void WorldImpl::SolveArticulations(double dt) {
       joint.effort = joint.def.mimic_multiplier * entry.model.joints[joint.def.mimic_joint].effort;
     }
   }
+}
+
+// The rigid bodies that touched links take the link solve's velocities.
+void WorldImpl::TakeLinkSolveVelocities() {
   const std::vector<ArticulationSolver::BodySlot>& slots = articulation_solver_.bodies();
   for (std::size_t index = 0; index < slots.size(); ++index) {
     const ArticulationSolver::BodySlot& slot_body = slots[index];
@@ -290,6 +309,53 @@ void WorldImpl::SolveArticulations(double dt) {
   }
 }
 
+// d . (velocity of the body's point at `point`) before this step's forces:
+// a link's from the joint-space velocity the step starts with, a rigid
+// body's from the momenta IntegrateForces started from.
+double WorldImpl::StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
+                                     std::uint32_t index, const Vec3& direction,
+                                     const Vec3& point) const {
+  const Body& body = bodies_[index];
+  const Vec3 r = point - body.position;
+  if (body.articulation >= 0) {
+    const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
+    const Eigen::VectorXd& u = articulations_[body.articulation].state.u;
+    const Vec3 linear = jacobian.topRows<3>() * u;
+    const Vec3 angular = jacobian.bottomRows<3>() * u;
+    return direction.dot(linear + angular.cross(r));
+  }
+  if (body.is_static || !body.awake || body.disabled) return 0.0;
+  const Vec3 angular = body.inverse_inertia_world * body.start_angular_momentum;
+  return direction.dot(body.start_linear_velocity + angular.cross(r));
+}
+
+// One side of a link-contact row along `direction` at `point`: a link's
+// through its Jacobian (J_v^T d + J_w^T (r x d)), a rigid body's through
+// its mass and inertia (a static or resting one has none).
+RowSide WorldImpl::LinkContactSide(const LinkRowContext& context, std::uint32_t index,
+                                   const Vec3& direction, const Vec3& point) {
+  const Body& body = bodies_[index];
+  if (body.articulation >= 0) {
+    const int articulation_slot = (*context.slot_of_articulation)[body.articulation];
+    const JacobianRows& jacobian = (*context.kinematics)[body.articulation].jacobian[body.link];
+    const Vec3 r = point - body.position;
+    const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
+                                jacobian.bottomRows<3>().transpose() * r.cross(direction);
+    return articulation_solver_.ArticulationSide(articulation_slot, row);
+  }
+  ArticulationSolver::BodySlot body_slot;
+  body_slot.body = index;
+  const bool moves = !body.is_static && body.awake && !body.disabled;
+  if (moves) {
+    body_slot.linear_velocity = body.linear_velocity;
+    body_slot.angular_velocity = body.angular_velocity;
+    body_slot.inverse_mass = body.inverse_mass;
+    body_slot.inverse_inertia_world = body.inverse_inertia_world;
+  }
+  return articulation_solver_.BodySide(articulation_solver_.BodySlotOf(body_slot), direction,
+                                       point - body.position);
+}
+
 // Per point of a pair with a link: a normal row and two friction rows. The
 // normal row's target follows the rigid bodies' classification: a point
 // touching and closing faster than the collision threshold bounces with
@@ -301,100 +367,71 @@ void WorldImpl::SolveArticulations(double dt) {
 // 1997, "Rigid Body Simulation II", section 8): a link resting on the
 // ground closes at g dt by the end of the free step, above the collision
 // threshold, and with e > 0 it would hop every step.
-void WorldImpl::AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
+void WorldImpl::AddLinkContactRows(const StepContext& step,
+                                   const std::vector<int>& slot_of_articulation,
                                    const std::vector<ArticulationKinematics>& kinematics) {
-  const SolverSettings& solver = settings_.solver;
-  // d . (velocity of the body's point at `point`) before this step's forces:
-  // a link's from the joint-space velocity the step starts with, a rigid
-  // body's from the momenta IntegrateForces started from.
-  auto start_velocity = [&](std::uint32_t index, const Vec3& direction, const Vec3& point) {
-    const Body& body = bodies_[index];
-    const Vec3 r = point - body.position;
-    if (body.articulation >= 0) {
-      const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
-      const Eigen::VectorXd& u = articulations_[body.articulation].state.u;
-      const Vec3 linear = jacobian.topRows<3>() * u;
-      const Vec3 angular = jacobian.bottomRows<3>() * u;
-      return direction.dot(linear + angular.cross(r));
-    }
-    if (body.is_static || !body.awake || body.disabled) return 0.0;
-    const Vec3 angular = body.inverse_inertia_world * body.start_angular_momentum;
-    return direction.dot(body.start_linear_velocity + angular.cross(r));
-  };
+  const LinkRowContext context{&slot_of_articulation, &kinematics};
   link_pair_rows_.assign(link_pairs_.size(), -1);
   link_penetrations_.clear();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
     const ShapePairContact& pair = *link_pairs_[m];
-    const Body& a = bodies_[pair.body_a];
-    const Body& b = bodies_[pair.body_b];
-    const Material& material_a = a.shapes[pair.shape_a].material;
-    const Material& material_b = b.shapes[pair.shape_b].material;
-    const double friction = CombineFriction(material_a.friction, material_b.friction);
-    const double restitution = CombineRestitution(material_a.restitution, material_b.restitution);
-    const Vec3 normal = pair.manifold.normal_world;
-    const std::array<Vec3, 2> tangent = TangentBasis(normal);
-    auto side = [&](std::uint32_t index, const Vec3& direction, const Vec3& point) {
-      const Body& body = bodies_[index];
-      if (body.articulation >= 0) {
-        const int articulation_slot = slot_of_articulation[body.articulation];
-        const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
-        const Vec3 r = point - body.position;
-        const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
-                                    jacobian.bottomRows<3>().transpose() * r.cross(direction);
-        return articulation_solver_.ArticulationSide(articulation_slot, row);
-      }
-      ArticulationSolver::BodySlot body_slot;
-      body_slot.body = index;
-      const bool moves = !body.is_static && body.awake && !body.disabled;
-      if (moves) {
-        body_slot.linear_velocity = body.linear_velocity;
-        body_slot.angular_velocity = body.angular_velocity;
-        body_slot.inverse_mass = body.inverse_mass;
-        body_slot.inverse_inertia_world = body.inverse_inertia_world;
-      }
-      return articulation_solver_.BodySide(articulation_solver_.BodySlotOf(body_slot), direction,
-                                           point - body.position);
-    };
     for (int i = 0; i < pair.manifold.point_count; ++i) {
-      const ContactPoint& point = pair.manifold.points[i];
-      ConstraintRow normal_row;
-      normal_row.kind = RowKind::kNormal;
-      normal_row.a = side(pair.body_a, normal, point.position_world);
-      normal_row.b = side(pair.body_b, -normal, point.position_world);
-      const double approach = start_velocity(pair.body_a, normal, point.position_world) +
-                              start_velocity(pair.body_b, -normal, point.position_world);
-      const double separation = point.separation;
-      if (separation <= solver.contact_tolerance &&
-          approach < -solver.collision_velocity_threshold) {
-        normal_row.target = -restitution * approach;
-        normal_row.colliding = true;
-      } else if (separation > 0.0) {
-        normal_row.target = -separation / dt;
-        if (approach < -solver.collision_velocity_threshold && approach * dt < -separation) {
-          normal_row.bounce = -restitution * approach;
-        }
-      } else {
-        normal_row.target = 0.0;
-      }
-      const double depth = -separation - solver.penetration_slop;
-      normal_row.impulse = pair.warm_start[i].normal_impulse;
-      const int normal_index = articulation_solver_.AddRow(std::move(normal_row));
-      if (depth > 0.0) {
-        link_penetrations_.emplace_back(normal_index, solver.position_correction * depth / dt);
-      }
+      const int normal_index = AddLinkPointRows(step, context, pair, i);
       if (i == 0) link_pair_rows_[m] = normal_index;
-      for (int t = 0; t < 2; ++t) {
-        ConstraintRow tangent_row;
-        tangent_row.kind = RowKind::kTangent;
-        tangent_row.a = side(pair.body_a, tangent[t], point.position_world);
-        tangent_row.b = side(pair.body_b, -tangent[t], point.position_world);
-        tangent_row.normal_row = normal_index;
-        tangent_row.friction = friction;
-        tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
-        articulation_solver_.AddRow(std::move(tangent_row));
-      }
     }
   }
+}
+
+// Point `i` of a link pair: its normal row (classified as above) and two
+// friction rows; returns the normal row's index.
+int WorldImpl::AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+                                const ShapePairContact& pair, int i) {
+  const SolverSettings& solver = settings_.solver;
+  const Body& a = bodies_[pair.body_a];
+  const Body& b = bodies_[pair.body_b];
+  const Material& material_a = a.shapes[pair.shape_a].material;
+  const Material& material_b = b.shapes[pair.shape_b].material;
+  const double friction = CombineFriction(material_a.friction, material_b.friction);
+  const double restitution = CombineRestitution(material_a.restitution, material_b.restitution);
+  const Vec3 normal = pair.manifold.normal_world;
+  const std::array<Vec3, 2> tangent = TangentBasis(normal);
+  const ContactPoint& point = pair.manifold.points[i];
+  ConstraintRow normal_row;
+  normal_row.kind = RowKind::kNormal;
+  normal_row.a = LinkContactSide(context, pair.body_a, normal, point.position_world);
+  normal_row.b = LinkContactSide(context, pair.body_b, -normal, point.position_world);
+  const double approach =
+      StartPointVelocity(*context.kinematics, pair.body_a, normal, point.position_world) +
+      StartPointVelocity(*context.kinematics, pair.body_b, -normal, point.position_world);
+  const double separation = point.separation;
+  if (separation <= solver.contact_tolerance && approach < -solver.collision_velocity_threshold) {
+    normal_row.target = -restitution * approach;
+    normal_row.colliding = true;
+  } else if (separation > 0.0) {
+    normal_row.target = -separation / step.dt;
+    if (approach < -solver.collision_velocity_threshold && approach * step.dt < -separation) {
+      normal_row.bounce = -restitution * approach;
+    }
+  } else {
+    normal_row.target = 0.0;
+  }
+  const double depth = -separation - solver.penetration_slop;
+  normal_row.impulse = pair.warm_start[i].normal_impulse;
+  const int normal_index = articulation_solver_.AddRow(std::move(normal_row));
+  if (depth > 0.0) {
+    link_penetrations_.emplace_back(normal_index, solver.position_correction * depth / step.dt);
+  }
+  for (int t = 0; t < 2; ++t) {
+    ConstraintRow tangent_row;
+    tangent_row.kind = RowKind::kTangent;
+    tangent_row.a = LinkContactSide(context, pair.body_a, tangent[t], point.position_world);
+    tangent_row.b = LinkContactSide(context, pair.body_b, -tangent[t], point.position_world);
+    tangent_row.normal_row = normal_index;
+    tangent_row.friction = friction;
+    tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
+    articulation_solver_.AddRow(std::move(tangent_row));
+  }
+  return normal_index;
 }
 
 // Restitution of the link contacts that close within the step. A link has
@@ -439,7 +476,8 @@ void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation)
 // chain, feed it. The split impulse of Bullet's sequential-impulse solver
 // (btSequentialImpulseConstraintSolver), in joint coordinates; the
 // projected Gauss-Seidel is Erleben 2007, section 3.
-void WorldImpl::CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation) {
+void WorldImpl::CorrectLinkPenetration(const StepContext& step,
+                                       const std::vector<int>& slot_of_articulation) {
   if (link_penetrations_.empty()) return;
   ArticulationSolver& pseudo = link_pseudo_solver_;
   pseudo.Reset();
@@ -498,7 +536,8 @@ void WorldImpl::CorrectLinkPenetration(double dt, const std::vector<int>& slot_o
     if (slot < 0 || pseudo_slot[slot] < 0) continue;
     ArticulationEntry& entry = articulations_[i];
     const Eigen::VectorXd velocity = entry.next.u;
-    entry.next = Advance(entry.model, entry.next, pseudo.articulations()[pseudo_slot[slot]].u, dt);
+    entry.next =
+        Advance(entry.model, entry.next, pseudo.articulations()[pseudo_slot[slot]].u, step.dt);
     entry.next.u = velocity;
   }
   for (const ArticulationSolver::BodySlot& slot_body : pseudo.bodies()) {
@@ -511,7 +550,7 @@ void WorldImpl::CorrectLinkPenetration(double dt, const std::vector<int>& slot_o
 
 // Keeps the link pairs' impulses for next step's warm start and reports
 // their points, as ReportContacts does for the rigid pairs.
-void WorldImpl::ReportLinkContacts(double dt) {
+void WorldImpl::ReportLinkContacts(const StepContext& step) {
   const std::vector<ConstraintRow>& rows = articulation_solver_.rows();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
     ShapePairContact& pair = *link_pairs_[m];
@@ -529,7 +568,7 @@ void WorldImpl::ReportLinkContacts(double dt) {
                         point.position_world};
       const bool touching = point.separation <= settings_.solver.contact_tolerance;
       if (!touching && normal.impulse <= 0.0) continue;
-      ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, tangent, dt));
+      ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, tangent, step));
       const bool colliding = normal.colliding && normal.impulse > 0.0;
       report.type = colliding ? ContactType::kColliding : ContactType::kResting;
       if (colliding) collision_log_.push_back(report);
@@ -540,7 +579,7 @@ void WorldImpl::ReportLinkContacts(double dt) {
 // Stage 5 for the articulations: each takes the state its solve chose, and
 // its links follow. A state that is not finite (forces that overflowed) is
 // refused: the articulation stays where it was, at rest.
-void WorldImpl::MoveArticulations(double /*dt*/) {
+void WorldImpl::MoveArticulations(const StepContext& /*step*/) {
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     ArticulationEntry& entry = articulations_[i];
     if (!entry.in_use) continue;

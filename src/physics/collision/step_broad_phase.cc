@@ -26,7 +26,7 @@ ProxyKind KindOf(const Body& body) {
 
 }  // namespace
 
-void WorldImpl::UpdateBroadPhase(double dt) {
+void WorldImpl::UpdateBroadPhase(const StepContext& step) {
   const double margin = settings_.contact_margin;
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& body = bodies_[i];
@@ -41,9 +41,10 @@ void WorldImpl::UpdateBroadPhase(double dt) {
     if (moving) {
       // The box swept over the predicted motion of the step, so that pairs
       // exist before the surfaces meet (and fast bodies cannot skip them).
-      const Vec3 motion = dt * body.linear_velocity + 0.5 * dt * dt * settings_.gravity;
+      const Vec3 motion =
+          step.dt * body.linear_velocity + 0.5 * step.dt * step.dt * settings_.gravity;
       box = box.Union(Aabb{box.min + motion, box.max + motion});
-      box = box.Fattened(margin + dt * body.angular_velocity.norm() * body.bounding_radius);
+      box = box.Fattened(margin + step.dt * body.angular_velocity.norm() * body.bounding_radius);
     } else {
       box = box.Fattened(margin);
     }

@@ -78,7 +78,7 @@ void CollideMeshSlots(const MeshVisit& visit, const ConvexMeshPair& pair) {
 
 }  // namespace
 
-void WorldImpl::UpdateNarrowPhase(double dt) {
+void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
   ++step_count_;
   last_step_profile_.reused_manifolds = 0;
   const std::vector<ProxyPair>& pairs = broad_phase_.Pairs();
@@ -98,7 +98,7 @@ void WorldImpl::UpdateNarrowPhase(double dt) {
     prefetch(ContactCache::Prefetch::kSlot, k + kSlotPrefetchAhead);
     prefetch(ContactCache::Prefetch::kEntry, k + kEntryPrefetchAhead);
     CollideBodies(static_cast<std::uint32_t>(pairs[k].first),
-                  static_cast<std::uint32_t>(pairs[k].second), dt);
+                  static_cast<std::uint32_t>(pairs[k].second), step);
   }
   for (const std::uint32_t plane : half_space_bodies_) {
     const Pose world_from_plane =
@@ -111,8 +111,8 @@ void WorldImpl::UpdateNarrowPhase(double dt) {
       // A body whose bounding sphere stays clear of the plane by the contact
       // distance has no pair with it to look at.
       const double clearance = normal.dot(body.position) - height - body.bounding_radius;
-      if (clearance >= ContactDistance(body, bodies_[plane], dt)) continue;
-      CollideBodies(i, plane, dt);
+      if (clearance >= ContactDistance(body, bodies_[plane], step)) continue;
+      CollideBodies(i, plane, step);
     }
   }
   // The listed shape pairs are tested after the walk, on the pool: a test
@@ -129,20 +129,20 @@ void WorldImpl::UpdateNarrowPhase(double dt) {
 }
 
 // m; the margin plus the distance the two bodies can close in one step.
-double WorldImpl::ContactDistance(const Body& a, const Body& b, double dt) const {
+double WorldImpl::ContactDistance(const Body& a, const Body& b, const StepContext& step) const {
   const double margin =
       std::min(settings_.contact_margin, kMarginPerThickness * std::min(a.thickness, b.thickness));
-  return margin + ContactReach(a, b, dt);
+  return margin + ContactReach(a, b, step);
 }
 
 // m; a bound on how far two points of the bodies can close in one step:
 // their relative speed, each body's turn times its bounding radius, and
 // gravity's half g dt^2.
-double WorldImpl::ContactReach(const Body& a, const Body& b, double dt) const {
+double WorldImpl::ContactReach(const Body& a, const Body& b, const StepContext& step) const {
   const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
                                a.angular_velocity.norm() * a.bounding_radius +
                                b.angular_velocity.norm() * b.bounding_radius;
-  return dt * closing_speed + 0.5 * dt * dt * settings_.gravity.norm();
+  return step.dt * closing_speed + 0.5 * step.dt * step.dt * settings_.gravity.norm();
 }
 
 // A face-defined manifold between polyhedra carried to the current poses
@@ -211,13 +211,13 @@ void WorldImpl::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shap
 // have travelled less than g minus the contact distance since: no point of
 // either has moved far enough to bring them within it (conservative
 // advancement's bound, kept across steps).
-void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt) {
+void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const StepContext& step) {
   MovingBodyFirst(bodies_, &body_a, &body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
   if (SkipsPair(a, b)) return;
-  const double contact_distance = ContactDistance(a, b, dt);
-  const double reach = ContactReach(a, b, dt);
+  const double contact_distance = ContactDistance(a, b, step);
+  const double reach = ContactReach(a, b, step);
   const double travel = a.travel + b.travel;
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;
   // The poses, made once and only for a pair that is looked at.

@@ -139,20 +139,20 @@ ImpactBracket NarrowImpactBracket(const PairSweep& sweep, double target_gap, dou
 // of its thickness per step is first sampled along its path, so that a thin
 // wall it would pass through entirely still shows a penetrating sample to
 // bracket. Pairs that cannot close their gap within the step are skipped.
-void WorldImpl::IntegrateBodies(double dt) {
-  MoveArticulations(dt);
-  DriftBodies(dt);
-  BoundBodyMotion(dt);
-  ResolveImpacts(dt, FindImpacts(dt, contact_cache_.seen()), contact_cache_.touching(), 0);
-  UpdateSleep(dt);
+void WorldImpl::IntegrateBodies(const StepContext& step) {
+  MoveArticulations(step);
+  DriftBodies(step);
+  BoundBodyMotion(step);
+  ResolveImpacts(step, FindImpacts(step, contact_cache_.seen()), contact_cache_.touching(), 0);
+  UpdateSleep(step);
 }
 
 // Scales a moving body's angular momenta (at the start and the end of the
 // step) so that its angular velocity turns it at most max_turn_per_step in
 // dt: |w| <= max_turn / dt with w = I^-1 L. The scale keeps the spin's axis;
 // it only takes energy out, and only from spins no step resolves.
-void WorldImpl::CapSpin(double dt) {
-  const double max_speed = settings_.max_turn_per_step / dt;
+void WorldImpl::CapSpin(const StepContext& step) {
+  const double max_speed = settings_.max_turn_per_step / step.dt;
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
     if (!body.awake || body.disabled) continue;
@@ -170,8 +170,8 @@ void WorldImpl::CapSpin(double dt) {
 // The awake bodies drift over the step; each one's path (start, end and
 // velocities) is kept for the time-of-impact search. paths_ is kept between
 // steps, so that a step neither allocates nor clears a path per body.
-void WorldImpl::DriftBodies(double dt) {
-  CapSpin(dt);
+void WorldImpl::DriftBodies(const StepContext& step) {
+  CapSpin(step);
   paths_.resize(bodies_.size());
   for (const std::uint32_t i : moving_bodies_) {
     const Body& body = bodies_[i];
@@ -181,9 +181,9 @@ void WorldImpl::DriftBodies(double dt) {
     path.start_velocity = body.start_linear_velocity;
     path.end_velocity = body.linear_velocity;
     path.pseudo_velocity = body.pseudo_linear_velocity;
-    path.dt = dt;
+    path.dt = step.dt;
   }
-  IntegratePositions(dt, moving_bodies_, &bodies_);
+  IntegratePositions(step.dt, moving_bodies_, &bodies_);
   DisableNonFiniteBodies();
   for (const std::uint32_t i : moving_bodies_) {
     if (bodies_[i].disabled) paths_[i].dt = 0.0;
@@ -191,7 +191,7 @@ void WorldImpl::DriftBodies(double dt) {
     if (path.dt == 0.0) continue;
     path.end = bodies_[i].WorldFromPrincipal();
     path.turn =
-        TurnBetween(path.start.rotation, path.end.rotation, dt * bodies_[i].angular_velocity);
+        TurnBetween(path.start.rotation, path.end.rotation, step.dt * bodies_[i].angular_velocity);
   }
 }
 
@@ -201,7 +201,7 @@ void WorldImpl::DriftBodies(double dt) {
 // radius dt max(|v0|, |v1|) (the velocity is linear in t); add the
 // split-impulse drift and the slerp angle times the shapes' reach from the
 // centre.
-void WorldImpl::BoundBodyMotion(double dt) {
+void WorldImpl::BoundBodyMotion(const StepContext& step) {
   for (const std::uint32_t i : moving_bodies_) {
     BodyPath& path = paths_[i];
     if (path.dt == 0.0) continue;
@@ -210,8 +210,8 @@ void WorldImpl::BoundBodyMotion(double dt) {
     const double displacement = (path.end.translation - path.start.translation).norm();
     path.fast =
         displacement + angle * radius > settings_.continuous_fraction * bodies_[i].thickness;
-    path.reach = dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
-                       path.pseudo_velocity.norm()) +
+    path.reach = step.dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
+                            path.pseudo_velocity.norm()) +
                  angle * radius;
     bodies_[i].travel += path.reach;
   }
@@ -223,7 +223,8 @@ void WorldImpl::BoundBodyMotion(double dt) {
 // Each pair's search reads the bodies and their paths and writes only its
 // own entry, so the pairs are searched on the pool, and the impacts listed
 // afterwards in the pairs' order: the same list for any number of threads.
-std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs) {
+std::vector<Impact> WorldImpl::FindImpacts(const StepContext& step,
+                                           const std::vector<ShapePairContact*>& pairs) {
   // A pair's search costs 0.1-10 us; a chunk this long amortizes taking it.
   constexpr std::size_t kPairsPerChunk = 64;
   impact_searches_.resize(pairs.size());
@@ -238,7 +239,7 @@ std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePai
     if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0) {
       return;
     }
-    search.time = PairImpactTime(dt, pair, &search.approach_speed);
+    search.time = PairImpactTime(step, pair, &search.approach_speed);
   });
   std::vector<Impact> impacts;
   for (std::size_t e = 0; e < pairs.size(); ++e) {
@@ -250,9 +251,25 @@ std::vector<Impact> WorldImpl::FindImpacts(double dt, const std::vector<ShapePai
   return impacts;
 }
 
+// The pair's gap at the start of the step: the nearest point of the
+// manifold, or, with no point, at least the distance the narrow phase
+// looked within, and at least the narrow phase's separating-axis gap less
+// what the bodies travelled between that test and the start of this step.
+double WorldImpl::PairStartGap(const ShapePairContact& pair) const {
+  const double travel_since = bodies_[pair.body_a].travel - paths_[pair.body_a].reach +
+                              bodies_[pair.body_b].travel - paths_[pair.body_b].reach -
+                              pair.apart_travel;
+  double start_gap = std::max(pair.contact_distance, pair.apart_gap - travel_since);
+  for (int i = 0; i < pair.manifold.point_count; ++i) {
+    start_gap = std::min(start_gap, pair.manifold.points[i].separation);
+  }
+  return start_gap;
+}
+
 // The time within the step at which the pair comes within the touching band,
 // or +infinity when it does not or is already in contact.
-double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* approach_speed) {
+double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair,
+                                 double* approach_speed) {
   constexpr double kNoImpact = std::numeric_limits<double>::infinity();
   *approach_speed = 0.0;
   double touching = settings_.solver.contact_tolerance;
@@ -262,16 +279,7 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* appr
   double target_gap = 0.05 * touching;
   const BodyPath& path_a = paths_[pair->body_a];
   const BodyPath& path_b = paths_[pair->body_b];
-  // The gap at the start: the nearest point of the manifold, or, with no
-  // point, at least the distance the narrow phase looked within, and at
-  // least the narrow phase's separating-axis gap less what the bodies
-  // travelled between that test and the start of this step.
-  const double travel_since = bodies_[pair->body_a].travel - path_a.reach +
-                              bodies_[pair->body_b].travel - path_b.reach - pair->apart_travel;
-  double start_gap = std::max(pair->contact_distance, pair->apart_gap - travel_since);
-  for (int i = 0; i < pair->manifold.point_count; ++i) {
-    start_gap = std::min(start_gap, pair->manifold.points[i].separation);
-  }
+  const double start_gap = PairStartGap(*pair);
   const bool fast = path_a.fast || path_b.fast;
   if (start_gap <= touching && !fast) return kNoImpact;
   if (bodies_[pair->body_a].disabled || bodies_[pair->body_b].disabled) return kNoImpact;
@@ -311,11 +319,11 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* appr
   if (samples == 1) {
     SeparatingWitness witness = pair->witness;
     ContactManifold manifold;
-    if (!Collide(sweep.InputAt(dt, target_gap), &witness, &manifold)) return kNoImpact;
+    if (!Collide(sweep.InputAt(step.dt, target_gap), &witness, &manifold)) return kNoImpact;
   }
   ImpactBracket bracket{0.0, start_gap, -1.0, 0.0};
   for (int k = 1; k <= samples; ++k) {
-    const double t = dt * k / samples;
+    const double t = step.dt * k / samples;
     const double bound = sweep.SphereGapAt(t);
     const double gap = bound > target_gap ? bound : sweep.GapAt(t);
     if (gap <= target_gap) {
@@ -332,7 +340,7 @@ double WorldImpl::PairImpactTime(double dt, ShapePairContact* pair, double* appr
   // by its reuse error, and a pair backed up to t = 0 again and again would
   // never reach the solver).
   pair->anchors.valid = false;
-  bracket = NarrowImpactBracket(sweep, target_gap, touching, dt, bracket);
+  bracket = NarrowImpactBracket(sweep, target_gap, touching, step.dt, bracket);
   // The gap's rate over the final bracket: the speed the surfaces meet at.
   *approach_speed = (bracket.gap_low - bracket.gap_high) / (bracket.high - bracket.low);
   return bracket.low;
@@ -399,7 +407,7 @@ void WorldImpl::DisableBody(std::uint32_t index) {
 // below 2 % of the sleep thresholds are noise: the residual velocities of a
 // stack at rest can grow steadily without going anywhere, and counted, they
 // kept the benchmark's pyramids awake.
-bool WorldImpl::UpdateSpeedingUp(double dt, Body* body) const {
+bool WorldImpl::UpdateSpeedingUp(const StepContext& step, Body* body) const {
   constexpr double kNoiseFraction = 0.02;
   const SleepSettings& sleep = settings_.sleep;
   const double speed = body->linear_velocity.norm();
@@ -410,7 +418,7 @@ bool WorldImpl::UpdateSpeedingUp(double dt, Body* body) const {
        angular_speed > kNoiseFraction * sleep.angular_velocity);
   body->last_speed = speed;
   body->last_angular_speed = angular_speed;
-  body->speeding_up_time = gaining ? body->speeding_up_time + dt : 0.0;
+  body->speeding_up_time = gaining ? body->speeding_up_time + step.dt : 0.0;
   return sleep.speeding_up_time > 0.0 && body->speeding_up_time >= sleep.speeding_up_time;
 }
 
@@ -418,7 +426,7 @@ bool WorldImpl::UpdateSpeedingUp(double dt, Body* body) const {
 // bodies (union-find). An island sleeps when every body in it has been slower
 // than the thresholds, or has kept within its sleep window, and not speeding
 // up, for time_to_sleep; it costs nothing until woken.
-void WorldImpl::UpdateSleep(double dt) {
+void WorldImpl::UpdateSleep(const StepContext& step) {
   const SleepSettings& sleep = settings_.sleep;
   if (!sleep.enabled) return;
   UnionFind islands(bodies_.size());
@@ -442,7 +450,7 @@ void WorldImpl::UpdateSleep(double dt) {
   for (const std::uint32_t i : moving_bodies_) {
     Body& body = bodies_[i];
     if (!body.awake) continue;
-    const bool speeding_up = UpdateSpeedingUp(dt, &body);
+    const bool speeding_up = UpdateSpeedingUp(step, &body);
     if (island_has_link[islands.Find(i)]) {
       // Held by, resting on or pushed by a link: its quiet time starts
       // over, so that once the link lets go it must be quiet for
@@ -457,11 +465,11 @@ void WorldImpl::UpdateSleep(double dt) {
         !speeding_up &&
         body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
         body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
-    body.sleep_time = slow ? body.sleep_time + dt : 0.0;
+    body.sleep_time = slow ? body.sleep_time + step.dt : 0.0;
     // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
     if (speeding_up) RestartSleepWindow(i);
     const double still_time =
-        UpdateSleepWindow(body.WorldFromPrincipal(), limits, dt, &sleep_windows_[i]);
+        UpdateSleepWindow(body.WorldFromPrincipal(), limits, step.dt, &sleep_windows_[i]);
     const double quiet_time = std::max(body.sleep_time, still_time);
     double& island = island_sleep_time[islands.Find(i)];
     island = std::min(island, quiet_time);

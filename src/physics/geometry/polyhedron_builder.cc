@@ -152,19 +152,17 @@ Result<double> CheckInput(const std::vector<Vec3>& vertices, const std::vector<L
   return scale;
 }
 
-// Merges coplanar neighbouring faces: faces are grouped by union-find over
-// shared edges, and each group's boundary (edges whose twin lies in another
-// group) is chained into one counter-clockwise loop. Interior edges and
-// vertices of a group disappear with it.
-Result<std::vector<Loop>> MergeCoplanarFaces(const std::vector<Vec3>& vertices,
-                                             const std::vector<Loop>& faces,
-                                             const std::unordered_map<std::int64_t, int>& edge_face,
-                                             double scale) {
+// Union-find over shared edges: two neighbouring faces join one group when
+// their normals agree in sign and each lies within the coplanar tolerance
+// of the other's plane. Returns each face's parent (FindRoot gives its group).
+std::vector<int> GroupCoplanarFaces(const std::vector<Vec3>& vertices,
+                                    const std::vector<Loop>& faces,
+                                    const std::unordered_map<std::int64_t, int>& edge_face,
+                                    double scale) {
   const int vertex_count = static_cast<int>(vertices.size());
   const int face_count = static_cast<int>(faces.size());
   std::vector<Plane> planes(face_count);
   for (int f = 0; f < face_count; ++f) planes[f] = PlaneOfLoop(vertices, faces[f]);
-
   std::vector<int> parent(face_count);
   std::iota(parent.begin(), parent.end(), 0);
   const double coplanar_distance = kCoplanarTolerance * scale;
@@ -182,12 +180,66 @@ Result<std::vector<Loop>> MergeCoplanarFaces(const std::vector<Vec3>& vertices,
       }
     }
   }
+  return parent;
+}
 
-  // Successor of each boundary vertex along the current group's boundary.
+// The boundary of one group of faces (edges whose twin lies in another
+// group), chained into one counter-clockwise loop; an error when it is not
+// a single simple polygon.
+Result<Loop> GroupBoundary(const std::vector<Loop>& faces, const std::vector<int>& group_faces,
+                           const std::unordered_map<std::int64_t, int>& edge_face, int vertex_count,
+                           std::vector<int>* parent) {
+  const int group = FindRoot(*parent, group_faces[0]);
+  const std::string around = "coplanar faces around face " + std::to_string(group_faces[0]);
+  // Successor of each boundary vertex along the group's boundary.
   std::unordered_map<int, int> successor;
+  int boundary_edge_count = 0;
+  int start = -1;
+  for (int f : group_faces) {
+    const Loop& face = faces[f];
+    for (std::size_t i = 0; i < face.size(); ++i) {
+      const int from = face[i];
+      const int to = face[(i + 1) % face.size()];
+      const int g = edge_face.at(EdgeKey(to, from, vertex_count));
+      if (FindRoot(*parent, g) == group) continue;
+      if (!successor.emplace(from, to).second) {
+        return Result<Loop>::Error("coplanar faces around face " + std::to_string(f) +
+                                   " merge into a polygon that touches itself at vertex " +
+                                   std::to_string(from));
+      }
+      ++boundary_edge_count;
+      start = from;
+    }
+  }
+  if (start < 0) return Result<Loop>::Error(around + " enclose nothing");
+  Loop loop;
+  int v = start;
+  do {
+    loop.push_back(v);
+    const auto it = successor.find(v);
+    if (it == successor.end() || static_cast<int>(loop.size()) > boundary_edge_count) {
+      return Result<Loop>::Error(around + " do not merge into a single polygon");
+    }
+    v = it->second;
+  } while (v != start);
+  if (static_cast<int>(loop.size()) != boundary_edge_count) {
+    return Result<Loop>::Error(around + " merge into a polygon with a hole");
+  }
+  return loop;
+}
+
+// Merges coplanar neighbouring faces: faces are grouped by union-find over
+// shared edges, and each group's boundary (edges whose twin lies in another
+// group) is chained into one counter-clockwise loop. Interior edges and
+// vertices of a group disappear with it.
+Result<std::vector<Loop>> MergeCoplanarFaces(const std::vector<Vec3>& vertices,
+                                             const std::vector<Loop>& faces,
+                                             const std::unordered_map<std::int64_t, int>& edge_face,
+                                             double scale) {
+  const int face_count = static_cast<int>(faces.size());
+  std::vector<int> parent = GroupCoplanarFaces(vertices, faces, edge_face, scale);
   std::vector<std::vector<int>> group_faces(face_count);
   for (int f = 0; f < face_count; ++f) group_faces[FindRoot(parent, f)].push_back(f);
-
   std::vector<Loop> merged;
   for (int group = 0; group < face_count; ++group) {
     if (group_faces[group].empty()) continue;
@@ -195,48 +247,10 @@ Result<std::vector<Loop>> MergeCoplanarFaces(const std::vector<Vec3>& vertices,
       merged.push_back(faces[group_faces[group][0]]);
       continue;
     }
-    successor.clear();
-    int boundary_edge_count = 0;
-    int start = -1;
-    for (int f : group_faces[group]) {
-      const Loop& face = faces[f];
-      for (std::size_t i = 0; i < face.size(); ++i) {
-        const int from = face[i];
-        const int to = face[(i + 1) % face.size()];
-        const int g = edge_face.at(EdgeKey(to, from, vertex_count));
-        if (FindRoot(parent, g) == group) continue;
-        if (!successor.emplace(from, to).second) {
-          return Result<std::vector<Loop>>::Error(
-              "coplanar faces around face " + std::to_string(f) +
-              " merge into a polygon that touches itself at vertex " + std::to_string(from));
-        }
-        ++boundary_edge_count;
-        start = from;
-      }
-    }
-    if (start < 0) {
-      return Result<std::vector<Loop>>::Error("coplanar faces around face " +
-                                              std::to_string(group_faces[group][0]) +
-                                              " enclose nothing");
-    }
-    Loop loop;
-    int v = start;
-    do {
-      loop.push_back(v);
-      const auto it = successor.find(v);
-      if (it == successor.end() || static_cast<int>(loop.size()) > boundary_edge_count) {
-        return Result<std::vector<Loop>>::Error("coplanar faces around face " +
-                                                std::to_string(group_faces[group][0]) +
-                                                " do not merge into a single polygon");
-      }
-      v = it->second;
-    } while (v != start);
-    if (static_cast<int>(loop.size()) != boundary_edge_count) {
-      return Result<std::vector<Loop>>::Error("coplanar faces around face " +
-                                              std::to_string(group_faces[group][0]) +
-                                              " merge into a polygon with a hole");
-    }
-    merged.push_back(std::move(loop));
+    Result<Loop> loop = GroupBoundary(faces, group_faces[group], edge_face,
+                                      static_cast<int>(vertices.size()), &parent);
+    if (!loop.ok()) return loop.status();
+    merged.push_back(std::move(loop).value());
   }
   return merged;
 }

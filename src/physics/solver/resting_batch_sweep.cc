@@ -52,6 +52,23 @@ template <bool kAllActive>
   }
 }
 
+// Each lane's (t_0, t_1) scaled onto the disc |t| <= limit where it lies
+// outside; the square roots only when some lane does.
+[[gnu::always_inline]] inline void ProjectOntoDisc(const LaneDoubles& limit,
+                                                   LaneDoubles tangent[2]) {
+  const LaneDoubles zero = {};
+  const LaneDoubles norm_squared = tangent[0] * tangent[0] + tangent[1] * tangent[1];
+  const LaneMask outside = norm_squared > limit * limit;
+  bool any_outside = false;
+  for (int lane = 0; lane < kBatchLanes; ++lane) any_outside |= outside[lane] != 0;
+  if (!any_outside) return;
+  const LaneDoubles norm = {std::sqrt(norm_squared[0]), std::sqrt(norm_squared[1]),
+                            std::sqrt(norm_squared[2]), std::sqrt(norm_squared[3])};
+  const LaneDoubles scale = norm > zero ? limit / norm : zero;
+  tangent[0] = outside ? tangent[0] * scale : tangent[0];
+  tangent[1] = outside ? tangent[1] * scale : tangent[1];
+}
+
 // UpdateRestingRow for the rows of one block, in the lanes of `active`:
 // v_r, the friction impulse projected onto its disc, the normal velocity
 // corrected by the friction change, the normal impulse projected onto
@@ -88,18 +105,7 @@ template <bool kAllActive>
     Dot(run.tangent[k], v, &tangent_velocity);
     tangent[k] = old_tangent[k] - row->tangent_mass * tangent_velocity;
   }
-  const LaneDoubles limit = run.friction * row->normal_impulse;
-  const LaneDoubles norm_squared = tangent[0] * tangent[0] + tangent[1] * tangent[1];
-  const LaneMask outside = norm_squared > limit * limit;
-  bool any_outside = false;
-  for (int lane = 0; lane < kBatchLanes; ++lane) any_outside |= outside[lane] != 0;
-  if (any_outside) {
-    const LaneDoubles norm = {std::sqrt(norm_squared[0]), std::sqrt(norm_squared[1]),
-                              std::sqrt(norm_squared[2]), std::sqrt(norm_squared[3])};
-    const LaneDoubles scale = norm > zero ? limit / norm : zero;
-    tangent[0] = outside ? tangent[0] * scale : tangent[0];
-    tangent[1] = outside ? tangent[1] * scale : tangent[1];
-  }
+  ProjectOntoDisc(run.friction * row->normal_impulse, tangent);
   LaneDoubles change[3];
   for (int k = 0; k < 2; ++k) {
     change[k + 1] = has_friction ? tangent[k] - old_tangent[k] : zero;

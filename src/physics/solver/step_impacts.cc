@@ -35,7 +35,7 @@ constexpr std::size_t kMaxSubStepBodies = 32;
 // (linked by touching pairs and by colliding impacts) that holds a colliding
 // impact goes back to its earliest impact and simulates the rest of h. A
 // body with only other impacts stays at its own earliest one.
-void WorldImpl::ResolveImpacts(double h, const std::vector<Impact>& impacts,
+void WorldImpl::ResolveImpacts(const StepContext& step, const std::vector<Impact>& impacts,
                                const std::vector<ShapePairContact*>& touching, int round) {
   const std::vector<std::uint32_t> moving = moving_bodies_;
   std::vector<std::vector<std::uint32_t>> islands;
@@ -57,7 +57,7 @@ void WorldImpl::ResolveImpacts(double h, const std::vector<Impact>& impacts,
       }
     }
     // An island's time is its earliest impact; only an island with a
-    // colliding impact goes on to the end of h.
+    // colliding impact goes on to the end of the interval.
     std::vector<double> root_time(bodies_.size(), std::numeric_limits<double>::infinity());
     std::vector<char> root_collides(bodies_.size(), 0);
     for (const Impact& impact : impacts) {
@@ -95,8 +95,8 @@ void WorldImpl::ResolveImpacts(double h, const std::vector<Impact>& impacts,
   }
   for (const std::uint32_t body : moving) paths_[body] = BodyPath{};
   for (std::size_t k = 0; k < islands.size(); ++k) {
-    const double rest = h - island_times[k];
-    if (rest > 0.0) SubStep(islands[k], rest, round + 1);
+    const double rest = step.dt - island_times[k];
+    if (rest > 0.0) SubStep(islands[k], step.Interval(rest), round + 1);
   }
   moving_bodies_ = moving;
 }
@@ -118,7 +118,8 @@ void WorldImpl::BackUpBody(std::uint32_t index, double time) {
 // against the rest of the world where it now is: fresh manifolds at the
 // current poses, the contact solve (collisions first), the drift, and the
 // impacts within h.
-void WorldImpl::SubStep(const std::vector<std::uint32_t>& island, double h, int round) {
+void WorldImpl::SubStep(const std::vector<std::uint32_t>& island, const StepContext& step,
+                        int round) {
   std::vector<char> member(bodies_.size(), 0);
   for (const std::uint32_t body : island) member[body] = 1;
   std::vector<ShapePairContact*> pairs;
@@ -127,7 +128,7 @@ void WorldImpl::SubStep(const std::vector<std::uint32_t>& island, double h, int 
   }
   std::vector<ShapePairContact*> touching;
   for (ShapePairContact* pair : pairs) {
-    RecollidePair(h, pair);
+    RecollidePair(step, pair);
     if (pair->manifold.point_count == 0) continue;
     if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0)
       continue;
@@ -135,15 +136,15 @@ void WorldImpl::SubStep(const std::vector<std::uint32_t>& island, double h, int 
     touching.push_back(pair);
   }
   moving_bodies_ = island;
-  SolveTouching(h, touching);
-  ReportContacts(touching, h, /*impacts_only=*/true);
-  DriftBodies(h);
-  BoundBodyMotion(h);
-  ResolveImpacts(h, FindImpacts(h, pairs), touching, round);
+  SolveTouching(step, touching);
+  ReportContacts(touching, step, /*impacts_only=*/true);
+  DriftBodies(step);
+  BoundBodyMotion(step);
+  ResolveImpacts(step, FindImpacts(step, pairs), touching, round);
 }
 
 // The pair's manifold clipped afresh at the current poses.
-void WorldImpl::RecollidePair(double h, ShapePairContact* pair) {
+void WorldImpl::RecollidePair(const StepContext& step, ShapePairContact* pair) {
   const Body& a = bodies_[pair->body_a];
   const Body& b = bodies_[pair->body_b];
   const ShapeDef& shape_a = a.shapes[pair->shape_a];
@@ -153,7 +154,7 @@ void WorldImpl::RecollidePair(double h, ShapePairContact* pair) {
   input.world_from_a = a.WorldFromBody() * shape_a.body_from_shape;
   input.b = &shape_b.geometry;
   input.world_from_b = b.WorldFromBody() * shape_b.body_from_shape;
-  input.contact_distance = ContactDistance(a, b, h);
+  input.contact_distance = ContactDistance(a, b, step);
   pair->contact_distance = input.contact_distance;
   CollideStats stats;
   Collide(input, &pair->witness, &pair->manifold, &stats);

@@ -59,7 +59,8 @@ void StoreVelocities(const std::vector<SolverBody>& solver_bodies,
 // `tangent` the basis of its normal (TangentBasis) that they are in; the
 // solver overwrites what it knows better for the pairs it solved.
 ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
-                                    const std::array<Vec3, 2>& tangent, double dt) const {
+                                    const std::array<Vec3, 2>& tangent,
+                                    const StepContext& step) const {
   const ContactPoint& contact = pair.manifold.points[i];
   const CachedImpulse& impulse = pair.previous[i];
   ContactReport report;
@@ -75,7 +76,7 @@ ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
   report.normal_impulse = impulse.normal_impulse;
   report.friction_impulse_world =
       impulse.tangent_impulse[0] * tangent[0] + impulse.tangent_impulse[1] * tangent[1];
-  report.normal_force = report.normal_impulse / dt;
+  report.normal_force = report.normal_impulse / step.dt;
   return report;
 }
 
@@ -91,7 +92,8 @@ ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
 // sags and rocks for its first tenth of a second. The estimate is only
 // where the iteration starts: the complementarity conditions, and so the
 // solution, are the same.
-void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt) {
+void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
+                                    const StepContext& step) {
   const double g = settings_.gravity.norm();
   if (g <= 0.0) return;
   const Vec3 up = -settings_.gravity / g;
@@ -140,7 +142,7 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
   std::vector<double> load(bodies_.size(), 0.0);
   std::vector<int> new_supports(bodies_.size(), 0);
   for (const Support& support : supports) {
-    load[support.upper] = bodies_[support.upper].mass * g * dt;
+    load[support.upper] = bodies_[support.upper].mass * g * step.dt;
     if (support.is_new) ++new_supports[support.upper];
   }
   auto warm_load = [&](const Support& support) {
@@ -174,7 +176,7 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
 // Baraff's order within a step: colliding contacts get impulses on the
 // velocities the step starts with, then the forces act, then the resting
 // contacts get the impulses that keep them apart, all contacts at once.
-void WorldImpl::SolveContacts(double dt) {
+void WorldImpl::SolveContacts(const StepContext& step) {
   // The bodies that move this step; the stages from here on visit only
   // them, so sleeping bodies cost nothing.
   moving_bodies_.clear();
@@ -187,25 +189,26 @@ void WorldImpl::SolveContacts(double dt) {
   // The contact solver takes the pairs of rigid bodies; the articulations'
   // solve, after it, the pairs with a link (step_articulations.cc).
   SplitLinkPairs(contact_cache_.touching());
-  SolveTouching(dt, rigid_pairs_);
-  SolveArticulations(dt);
-  ReportContacts(rigid_pairs_, dt, /*impacts_only=*/false);
-  ReportLinkContacts(dt);
+  SolveTouching(step, rigid_pairs_);
+  SolveArticulations(step);
+  ReportContacts(rigid_pairs_, step, /*impacts_only=*/false);
+  ReportLinkContacts(step);
 }
 
 // The contact solve of the touching pairs over dt, for the bodies of
 // moving_bodies_; the others are held where they are.
-void WorldImpl::SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs) {
-  solver_.Reset(settings_.solver, dt, bodies_.size());
+void WorldImpl::SolveTouching(const StepContext& step,
+                              const std::vector<ShapePairContact*>& pairs) {
+  solver_.Reset(settings_.solver, step.dt, bodies_.size());
   LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
   BuildSolverManifolds(pairs);
-  SeedNewSupportLoads(pairs, dt);
+  SeedNewSupportLoads(pairs, step);
   solver_.Prepare();
 
   solver_.ResolveCollisions();
   solver_.RecordStartVelocities();
   StoreVelocities(solver_.bodies(), moving_bodies_, &bodies_);
-  IntegrateForces(settings_.gravity, dt, moving_bodies_, &bodies_);
+  IntegrateForces(settings_.gravity, step.dt, moving_bodies_, &bodies_);
   DisableNonFiniteBodies();
   LoadVelocities(bodies_, moving_bodies_, pairs, &solver_.bodies());
   solver_.SolveRestingContacts();
@@ -292,10 +295,10 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
 
 // Keeps the impulses for next step's warm start, and reports the points
 // that touch, after the sleeping pairs' reports.
-void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt,
+void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
                                bool impacts_only) {
   const std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  if (!impacts_only) ReportSleepingContacts(dt);
+  if (!impacts_only) ReportSleepingContacts(step);
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
     const SolverManifold& manifold = manifolds[m];
@@ -314,11 +317,11 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, doub
       const bool reported = point.type == ContactType::kColliding ? collided : touching;
       if (!reported || (impacts_only && !collided)) continue;
       ContactReport& report =
-          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, dt));
+          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, step));
       report.normal_velocity = point.normal_velocity_before;
       report.type = point.type;
       report.normal_impulse = impulse;
-      report.normal_force = report.normal_impulse / dt;
+      report.normal_force = report.normal_impulse / step.dt;
       if (report.type == ContactType::kColliding) collision_log_.push_back(report);
     }
   }
@@ -331,14 +334,14 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, doub
 // Sleeping bodies keep the contacts they fell asleep with; their reports are
 // made again only when the list of sleeping pairs changes, and the reports
 // of this step follow them.
-void WorldImpl::ReportSleepingContacts(double dt) {
+void WorldImpl::ReportSleepingContacts(const StepContext& step) {
   if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
     contacts_.clear();
     for (const ShapePairContact* pair : contact_cache_.sleeping()) {
       const std::array<Vec3, 2> tangent = TangentBasis(pair->manifold.normal_world);
       for (int i = 0; i < pair->manifold.point_count; ++i) {
         if (pair->manifold.points[i].separation > settings_.solver.contact_tolerance) continue;
-        contacts_.push_back(MakeReport(*pair, i, tangent, dt));
+        contacts_.push_back(MakeReport(*pair, i, tangent, step));
       }
     }
     sleeping_reports_version_ = contact_cache_.sleeping_version();

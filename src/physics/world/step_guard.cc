@@ -52,7 +52,7 @@ bool StateIsSafe(const Body& body) {
 
 }  // namespace
 
-void WorldImpl::GuardBeforeStep(double dt) {
+void WorldImpl::GuardBeforeStep(const StepContext& step) {
   guard_start_poses_.resize(bodies_.size());
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& body = bodies_[i];
@@ -60,7 +60,7 @@ void WorldImpl::GuardBeforeStep(double dt) {
     if (!body.in_use || body.is_static || body.disabled || body.articulation >= 0) continue;
     const bool pose_is_finite = body.position.allFinite() && IsFinite(body.orientation);
     if (pose_is_finite) guard_start_poses_[i] = body.WorldFromPrincipal();
-    if (!body.awake || StepIsSafe(body, dt)) continue;
+    if (!body.awake || StepIsSafe(body, step.dt)) continue;
     // A pose that is not finite cannot come from the API (it refuses one),
     // so the start of the step is the last finite pose there is.
     FreezeBody(i, pose_is_finite ? body.WorldFromPrincipal() : guard_start_poses_[i]);

@@ -110,7 +110,11 @@ Status WorldImpl::SetSettings(const WorldSettings& settings) {
   return status;
 }
 
-Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
+namespace {
+
+// A body definition's pose, velocities and shapes, checked before any of it
+// enters the world.
+Status ValidateBodyDef(const BodyDef& def) {
   if (Status status = ValidateState(def.world_from_body, def.linear_velocity, def.angular_velocity);
       !status.ok()) {
     return status;
@@ -135,6 +139,13 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
     return Status::Error("a body may have at most " + std::to_string(kMaxShapesPerBody) +
                          " shapes, got " + std::to_string(def.shapes.size()));
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
+  if (Status status = ValidateBodyDef(def); !status.ok()) return status;
   if (body_count_ >= kMaxBodies) {
     return Status::Error("the world is full: " + std::to_string(kMaxBodies) + " bodies");
   }
@@ -335,7 +346,7 @@ std::vector<ContactReport> WorldImpl::TakeCollisionLog() {
 }
 
 void WorldImpl::Step() {
-  const double dt = settings_.time_step;
+  const StepContext step(settings_, pool_.get());
   non_finite_bodies_.clear();
   // Wall time since the previous lap, ms; steady_clock costs tens of
   // nanoseconds a read, nothing next to a stage.
@@ -348,16 +359,16 @@ void WorldImpl::Step() {
   };
   StepProfile& profile = last_step_profile_;
 
-  GuardBeforeStep(dt);
-  UpdateBroadPhase(dt);
+  GuardBeforeStep(step);
+  UpdateBroadPhase(step);
   profile.broad_phase_ms = lap();
-  UpdateNarrowPhase(dt);
+  UpdateNarrowPhase(step);
   profile.narrow_phase_ms = lap();
   UpdateContactCache();
   profile.contact_cache_ms = lap();
-  SolveContacts(dt);
+  SolveContacts(step);
   profile.solver_ms = lap();
-  IntegrateBodies(dt);
+  IntegrateBodies(step);
   profile.integrator_ms = lap();
   GuardAfterStep();
 
@@ -368,7 +379,7 @@ void WorldImpl::Step() {
   profile.velocity_sweeps = solver_.velocity_sweeps();
   profile.velocity_row_updates = solver_.velocity_row_updates();
   profile.island_groups = solver_.island_groups();
-  time_ += dt;
+  time_ += step.dt;
 }
 
 }  // namespace rigid_body_sim::physics

@@ -18,6 +18,7 @@
 #include "physics/dynamics/integrator.h"
 #include "physics/dynamics/sleep_window.h"
 #include "physics/solver/contact_solver.h"
+#include "physics/world/step_context.h"
 #include "physics/world/task_pool.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
@@ -128,57 +129,60 @@ class WorldImpl {
   void WakeTouching(std::uint32_t body);
 
   // The stages of Step, in order, one file each (step_*.cc).
-  void UpdateBroadPhase(double dt);   // 1. broad phase: swept boxes, candidate pairs
-  void UpdateNarrowPhase(double dt);  // 2. narrow phase: manifolds per shape pair
-  void UpdateContactCache();          // 3. contact cache: witnesses, warm starts
-  void SolveContacts(double dt);      // 4. solver: collisions, forces, resting contact
+  void UpdateBroadPhase(const StepContext& step);   // 1. broad phase: swept boxes, candidate pairs
+  void UpdateNarrowPhase(const StepContext& step);  // 2. narrow phase: manifolds per shape pair
+  void UpdateContactCache();                        // 3. contact cache: witnesses, warm starts
+  void SolveContacts(const StepContext& step);  // 4. solver: collisions, forces, resting contact
   // Stage 4's parts (step_solver.cc).
-  void SolveTouching(double dt, const std::vector<ShapePairContact*>& pairs);
+  void SolveTouching(const StepContext& step, const std::vector<ShapePairContact*>& pairs);
   void HoldPushedBodies();
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
-  void ReportContacts(const std::vector<ShapePairContact*>& pairs, double dt, bool impacts_only);
-  void ReportSleepingContacts(double dt);
-  void IntegrateBodies(double dt);  // 5. integrator: drift, time of impact, sleep
+  void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
+                      bool impacts_only);
+  void ReportSleepingContacts(const StepContext& step);
+  void IntegrateBodies(const StepContext& step);  // 5. integrator: drift, time of impact, sleep
   // Stage 5's parts (step_integrator.cc, step_impacts.cc).
-  void CapSpin(double dt);
-  void DriftBodies(double dt);
-  void BoundBodyMotion(double dt);
-  std::vector<Impact> FindImpacts(double dt, const std::vector<ShapePairContact*>& pairs);
+  void CapSpin(const StepContext& step);
+  void DriftBodies(const StepContext& step);
+  void BoundBodyMotion(const StepContext& step);
+  std::vector<Impact> FindImpacts(const StepContext& step,
+                                  const std::vector<ShapePairContact*>& pairs);
   // Time of impact within dt, or +infinity; with the speed the surfaces
   // meet at, m/s.
-  double PairImpactTime(double dt, ShapePairContact* pair, double* approach_speed);
-  void ResolveImpacts(double h, const std::vector<Impact>& impacts,
+  double PairImpactTime(const StepContext& step, ShapePairContact* pair, double* approach_speed);
+  void ResolveImpacts(const StepContext& step, const std::vector<Impact>& impacts,
                       const std::vector<ShapePairContact*>& touching, int round);
   void BackUpBody(std::uint32_t index, double time);
-  void SubStep(const std::vector<std::uint32_t>& island, double h, int round);
-  void RecollidePair(double h, ShapePairContact* pair);
+  void SubStep(const std::vector<std::uint32_t>& island, const StepContext& step, int round);
+  void RecollidePair(const StepContext& step, ShapePairContact* pair);
   int PathSamples(std::uint32_t body_a, std::uint32_t body_b) const;
   double PairThickness(const ShapePairContact& pair) const;
+  double PairStartGap(const ShapePairContact& pair) const;
   // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
   // a static mesh's are tested at once.
-  void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, double dt);
+  void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const StepContext& step);
   // Tests one listed shape pair: carries its manifold or clips a new one.
   void CollideShapePair(NarrowJob* job) const;
-  double ContactDistance(const Body& a, const Body& b, double dt) const;
-  double ContactReach(const Body& a, const Body& b, double dt) const;
+  double ContactDistance(const Body& a, const Body& b, const StepContext& step) const;
+  double ContactReach(const Body& a, const Body& b, const StepContext& step) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
                       const Pose& world_from_shape_b, ShapePairContact* entry) const;
-  void UpdateSleep(double dt);
-  bool UpdateSpeedingUp(double dt, Body* body) const;
+  void UpdateSleep(const StepContext& step);
+  bool UpdateSpeedingUp(const StepContext& step, Body* body) const;
   void DisableNonFiniteBodies();
   void DisableBody(std::uint32_t index);
   // The step guard (step_guard.cc), around stages 1-5: bodies whose state
   // or pending force would overflow a step are frozen before it, bodies
   // whose state is not finite after it go back to their pose at its start.
-  void GuardBeforeStep(double dt);
+  void GuardBeforeStep(const StepContext& step);
   void GuardAfterStep();
   void FreezeBody(std::uint32_t index, const Pose& world_from_principal);
   // `pairs` are the touching pairs, one per solver manifold.
-  void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, double dt);
+  void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
   ContactReport MakeReport(const ShapePairContact& pair, int point,
-                           const std::array<Vec3, 2>& tangent, double dt) const;
+                           const std::array<Vec3, 2>& tangent, const StepContext& step) const;
 
   // Articulations (world_articulations.cc, step_articulations.cc).
   Status MoveArticulation(std::uint32_t index, const Pose& world_from_link,
@@ -188,14 +192,31 @@ class WorldImpl {
   // Splits the touching pairs into those of rigid bodies only (the contact
   // solver's) and those with a link (the articulation solve's).
   void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
-  void SolveArticulations(double dt);
+  void SolveArticulations(const StepContext& step);
+  int SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
+                        ArticulationKinematics* kinematics);
+  void RecordJointEfforts(const StepContext& step);
+  void TakeLinkSolveVelocities();
   void AddArticulationRows(std::uint32_t index, int slot, const std::vector<JointRowSpec>& rows);
-  void CorrectLinkPenetration(double dt, const std::vector<int>& slot_of_articulation);
+  void CorrectLinkPenetration(const StepContext& step,
+                              const std::vector<int>& slot_of_articulation);
   void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
-  void AddLinkContactRows(double dt, const std::vector<int>& slot_of_articulation,
+  // What a link-contact row's sides read: each articulation's solver slot
+  // and kinematics this step.
+  struct LinkRowContext {
+    const std::vector<int>* slot_of_articulation;
+    const std::vector<ArticulationKinematics>* kinematics;
+  };
+  void AddLinkContactRows(const StepContext& step, const std::vector<int>& slot_of_articulation,
                           const std::vector<ArticulationKinematics>& kinematics);
-  void ReportLinkContacts(double dt);
-  void MoveArticulations(double dt);
+  int AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+                       const ShapePairContact& pair, int i);
+  RowSide LinkContactSide(const LinkRowContext& context, std::uint32_t index, const Vec3& direction,
+                          const Vec3& point);
+  double StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
+                            std::uint32_t index, const Vec3& direction, const Vec3& point) const;
+  void ReportLinkContacts(const StepContext& step);
+  void MoveArticulations(const StepContext& step);
 
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;      // settings_.threads threads
@@ -235,7 +256,9 @@ class WorldImpl {
   std::vector<ArticulationEntry> articulations_;
   ArticulationSolver articulation_solver_;
   ArticulatedBodyScratch articulation_scratch_;  // SolveArticulations'
-  std::vector<ShapePairContact*> rigid_pairs_;   // SplitLinkPairs'
+  std::vector<JointRowSpec> joint_row_scratch_;  // SetUpArticulation's
+  Eigen::VectorXd acceleration_scratch_;
+  std::vector<ShapePairContact*> rigid_pairs_;  // SplitLinkPairs'
   std::vector<ShapePairContact*> link_pairs_;
   // Per link pair, the index of its first normal row, or -1.
   std::vector<int> link_pair_rows_;
