@@ -283,7 +283,7 @@ std::vector<ParamRange> NodeParamRanges(const NodeOptions& options) {
   auto count = [](auto value) { return static_cast<double>(value); };
   return {
       {"~max_links_per_model", count(options.max_links_per_model), 1, 1e9, ""},
-      // The articulation holds at most 1000 links (world_articulations.cc).
+      // The articulation holds at most 1000 links (articulation_system.cc).
       {"~max_joints_per_model", count(options.max_joints_per_model), 1, 999, ""},
       {"~max_mesh_triangles", count(options.max_mesh_triangles), 1,
        count(physics::CollisionMesh::kMaxTriangles), ""},

@@ -215,7 +215,7 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const 
   MovingBodyFirst(bodies_, &body_a, &body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
-  if (SkipsPair(a, b)) return;
+  if (articulations_.SkipsPair(a, b)) return;
   const double contact_distance = ContactDistance(a, b, step);
   const double reach = ContactReach(a, b, step);
   const double travel = a.travel + b.travel;

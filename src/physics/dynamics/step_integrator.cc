@@ -140,7 +140,7 @@ ImpactBracket NarrowImpactBracket(const PairSweep& sweep, double target_gap, dou
 // wall it would pass through entirely still shows a penetrating sample to
 // bracket. Pairs that cannot close their gap within the step are skipped.
 void WorldImpl::IntegrateBodies(const StepContext& step) {
-  MoveArticulations(step);
+  articulations_.Move();
   DriftBodies(step);
   BoundBodyMotion(step);
   ResolveImpacts(step, FindImpacts(step, contact_cache_.seen()), contact_cache_.touching(), 0);
@@ -438,7 +438,7 @@ void WorldImpl::UpdateSleep(const StepContext& step) {
   }
   // Articulations never sleep, nor does what touches them.
   std::vector<char> island_has_link(bodies_.size(), 0);
-  for (const ShapePairContact* pair : link_pairs_) {
+  for (const ShapePairContact* pair : articulations_.link_pairs()) {
     for (const std::uint32_t index : {pair->body_a, pair->body_b}) {
       if (bodies_[index].articulation >= 0) island_has_link[islands.Find(index)] = 1;
     }

@@ -1,4 +1,4 @@
-// The contact solver's set-up: tangent bases, material combination, and the
+// The contact solver's set-up: tangent bases, combined materials, and the
 // classification of every point by its relative normal velocity. The two
 // solves are in collision_impulses.cc (colliding contact) and
 // resting_contact.cc with resting_islands.cc (resting contact).
@@ -8,20 +8,6 @@
 #include <cmath>
 
 namespace rigid_body_sim::physics {
-
-std::array<Vec3, 2> TangentBasis(const Vec3& normal) {
-  const Vec3 helper = std::abs(normal.x()) < 0.57 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 t1 = normal.cross(helper).normalized();
-  return {t1, normal.cross(t1)};
-}
-
-double CombineRestitution(double restitution_a, double restitution_b) {
-  return std::max(restitution_a, restitution_b);
-}
-
-double CombineFriction(double friction_a, double friction_b) {
-  return std::sqrt(friction_a * friction_b);
-}
 
 void ContactSolver::Reset(const SolverSettings& settings, double time_step,
                           std::size_t body_count) {

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "physics/contact/contact_frame.h"
 #include "physics/contact/contact_manifold.h"
 #include "physics/solver/resting_batches.h"
 #include "physics/world/task_pool.h"
@@ -61,14 +62,6 @@ struct SolverManifold {
   int point_count = 0;
   std::array<SolverPoint, ContactManifold::kMaxPoints> points;
 };
-
-// The tangent basis of a contact normal: a unit t1 orthogonal to n, and
-// t2 = n x t1. It depends on n only, so warm starts carry over.
-std::array<Vec3, 2> TangentBasis(const Vec3& normal);
-
-// Combination rules: e = max(ea, eb), mu = sqrt(mu_a mu_b).
-double CombineRestitution(double restitution_a, double restitution_b);
-double CombineFriction(double friction_a, double friction_b);
 
 // One touching point as the resting solve sweeps it: the manifold's frame
 // and the point's lever arms and masses copied next to its impulses.

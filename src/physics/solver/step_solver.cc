@@ -187,12 +187,12 @@ void WorldImpl::SolveContacts(const StepContext& step) {
     }
   }
   // The contact solver takes the pairs of rigid bodies; the articulations'
-  // solve, after it, the pairs with a link (step_articulations.cc).
-  SplitLinkPairs(contact_cache_.touching());
+  // system, after it, the pairs with a link (articulation_step.cc).
+  articulations_.TakeLinkPairs(contact_cache_.touching(), &rigid_pairs_);
   SolveTouching(step, rigid_pairs_);
-  SolveArticulations(step);
+  articulations_.Solve(step);
   ReportContacts(rigid_pairs_, step, /*impacts_only=*/false);
-  ReportLinkContacts(step);
+  articulations_.ReportContacts(step, &contacts_, &collision_log_);
 }
 
 // The contact solve of the touching pairs over dt, for the bodies of

@@ -10,77 +10,17 @@
 #include <variant>
 
 #include "physics/collision/mesh_collision.h"
+#include "physics/dynamics/body_state.h"
 #include "physics/geometry/shape_bounds.h"
 
 namespace rigid_body_sim::physics {
 namespace {
 
-constexpr double kUnitQuaternionTolerance = 1e-6;
 // Limits of the contact cache's keys.
 constexpr std::size_t kMaxShapesPerBody = 4096;
 constexpr std::size_t kMaxBodies = std::size_t{1} << 20;
 
-std::string Describe(const Vec3& v) {
-  std::ostringstream out;
-  out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
-  return out.str();
-}
-
 }  // namespace
-
-Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
-                     const Vec3& angular_velocity) {
-  if (!IsFinite(world_from_body.translation)) {
-    return Status::Error("position is not finite: " + Describe(world_from_body.translation));
-  }
-  if (!IsFinite(world_from_body.rotation)) {
-    return Status::Error("orientation quaternion is not finite");
-  }
-  const double norm = world_from_body.rotation.norm();
-  if (std::abs(norm - 1.0) > kUnitQuaternionTolerance) {
-    return Status::Error("orientation quaternion is not unit length (norm " + std::to_string(norm) +
-                         ")");
-  }
-  if (!IsFinite(linear_velocity)) {
-    return Status::Error("linear velocity is not finite: " + Describe(linear_velocity));
-  }
-  if (!IsFinite(angular_velocity)) {
-    return Status::Error("angular velocity is not finite: " + Describe(angular_velocity));
-  }
-  return Status::Ok();
-}
-
-// Sets (x, q, P, L) from the pose of the body frame and the twist of its
-// origin: v_com = v_origin + omega x (x_com - p_origin), P = M v_com,
-// L = I_world omega.
-void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
-                  const Vec3& angular_velocity, Body* body) {
-  const Pose world_from_principal = world_from_body * body->principal_from_body.Inverse();
-  body->position = world_from_principal.translation;
-  body->orientation = world_from_principal.rotation.normalized();
-  if (body->is_static) {
-    body->linear_momentum.setZero();
-    body->angular_momentum.setZero();
-  } else {
-    const Vec3 com_velocity =
-        linear_velocity + angular_velocity.cross(body->position - world_from_body.translation);
-    body->linear_momentum = body->mass * com_velocity;
-    const Mat3 rotation = body->orientation.toRotationMatrix();
-    const Vec3 principal_moments = body->inverse_principal_moments.cwiseInverse();
-    body->angular_momentum =
-        rotation * principal_moments.asDiagonal() * rotation.transpose() * angular_velocity;
-  }
-  body->force.setZero();
-  body->torque.setZero();
-  body->pseudo_linear_velocity.setZero();
-  body->pseudo_angular_velocity.setZero();
-  body->awake = true;
-  body->sleep_time = 0.0;
-  body->speeding_up_time = 0.0;
-  body->UpdateDerived();
-  body->start_linear_velocity = body->linear_velocity;
-  body->start_angular_momentum = body->angular_momentum;
-}
 
 namespace {
 
@@ -204,6 +144,15 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
   return id;
 }
 
+BodyId WorldImpl::BodyIdOf(std::uint32_t index) const {
+  return BodyId{index, bodies_[index].generation};
+}
+
+void WorldImpl::RestartContacts(std::uint32_t body) {
+  WakeTouching(body);
+  contact_cache_.RemoveBody(body);
+}
+
 Status WorldImpl::DestroyBody(BodyId id) {
   if (!IsValid(id)) return Status::Error("no body with this id");
   Body& body = bodies_[id.index];
@@ -257,8 +206,9 @@ Status WorldImpl::SetState(BodyId id, const Pose& world_from_body, const Vec3& l
   }
   Body& body = MutableBody(id);
   if (body.articulation >= 0) {
-    return MoveArticulation(static_cast<std::uint32_t>(body.articulation), world_from_body,
-                            linear_velocity, angular_velocity, body.link);
+    return articulations_.MoveWithLink(static_cast<std::uint32_t>(body.articulation),
+                                       world_from_body, linear_velocity, angular_velocity,
+                                       body.link);
   }
   body.disabled = false;
   SetBodyState(world_from_body, linear_velocity, angular_velocity, &body);
@@ -276,8 +226,10 @@ Status WorldImpl::SetState(BodyId id, const Pose& world_from_body, const Vec3& l
 
 Status WorldImpl::ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Vec3& point_world) {
   if (!IsValid(id)) return Status::Error("no body with this id");
-  if (!IsFinite(force_world)) return Status::Error("force is not finite: " + Describe(force_world));
-  if (!IsFinite(point_world)) return Status::Error("point is not finite: " + Describe(point_world));
+  if (!IsFinite(force_world))
+    return Status::Error("force is not finite: " + FormatVector(force_world));
+  if (!IsFinite(point_world))
+    return Status::Error("point is not finite: " + FormatVector(point_world));
   Body& body = MutableBody(id);
   if (body.is_static) return Status::Ok();
   Wake(id.index);
@@ -289,7 +241,7 @@ Status WorldImpl::ApplyForceAtPoint(BodyId id, const Vec3& force_world, const Ve
 Status WorldImpl::ApplyTorque(BodyId id, const Vec3& torque_world) {
   if (!IsValid(id)) return Status::Error("no body with this id");
   if (!IsFinite(torque_world)) {
-    return Status::Error("torque is not finite: " + Describe(torque_world));
+    return Status::Error("torque is not finite: " + FormatVector(torque_world));
   }
   Body& body = MutableBody(id);
   if (body.is_static) return Status::Ok();

@@ -11,8 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "physics/articulation/articulation_dynamics.h"
-#include "physics/articulation/articulation_solver.h"
+#include "physics/articulation/articulation_system.h"
 #include "physics/collision/broad_phase.h"
 #include "physics/contact/contact_cache.h"
 #include "physics/dynamics/integrator.h"
@@ -46,48 +45,15 @@ struct NarrowJob {
   bool reused = false;  // the manifold was carried, not clipped (out)
 };
 
-// Refuses a non-finite pose or velocity, or a quaternion not of unit length.
-Status ValidateState(const Pose& world_from_body, const Vec3& linear_velocity,
-                     const Vec3& angular_velocity);
-
-// Sets a body's state (x, q, P, L) from the pose of its body frame and the
-// twist of that frame's origin, and restarts its sleep and step records.
-void SetBodyState(const Pose& world_from_body, const Vec3& linear_velocity,
-                  const Vec3& angular_velocity, Body* body);
-
-// An articulation in the world: its model, its state, and the state its
-// constraint solve chose for the end of the step.
-// One joint row before it has a solver slot: the row on its dof `column`
-// (sign: +1 pushes the joint forward), as ConstraintRow's fields.
-struct JointRowSpec {
-  int joint = -1;
-  int column = 0;
-  double sign = 1.0;
-  RowKind kind = RowKind::kBounded;
-  double target = 0.0;  // velocity units of the row
-  double bound = 0.0;   // |impulse| <= bound (kBounded)
-  double softness = 0.0;
-};
-
-struct ArticulationEntry {
-  ArticulationModel model;
-  ArticulationState state;
-  ArticulationState next;
-  ServoGains gains;
-  FreeMotionSplit free_motion_split;
-  bool in_use = false;
-  std::uint32_t generation = 0;
-};
-
 // The public methods do what World's of the same name are documented to do.
-class WorldImpl {
+class WorldImpl : public LinkBodies {
  public:
   explicit WorldImpl(const WorldSettings& settings);
 
   const WorldSettings& settings() const { return settings_; }
   Status SetSettings(const WorldSettings& settings);
-  Result<BodyId> CreateBody(const BodyDef& def);
-  Status DestroyBody(BodyId id);
+  Result<BodyId> CreateBody(const BodyDef& def) override;
+  Status DestroyBody(BodyId id) override;
   bool IsValid(BodyId id) const;
   std::size_t BodyCount() const { return body_count_; }
   std::size_t AwakeBodyCount() const;
@@ -108,20 +74,34 @@ class WorldImpl {
   const std::vector<ContactReport>& contacts() const { return contacts_; }
   std::vector<ContactReport> TakeCollisionLog();
 
-  // Articulations (world_articulations.cc).
-  Result<ArticulationId> CreateArticulation(const ArticulationDef& def);
-  Status DestroyArticulation(ArticulationId id);
-  bool IsValid(ArticulationId id) const;
-  std::vector<BodyId> ArticulationLinks(ArticulationId id) const;
-  std::vector<JointState> GetJointStates(ArticulationId id) const;
+  // Articulations (articulation/articulation_system.h).
+  Result<ArticulationId> CreateArticulation(const ArticulationDef& def) {
+    return articulations_.Create(def);
+  }
+  Status DestroyArticulation(ArticulationId id) { return articulations_.Destroy(id); }
+  bool IsValid(ArticulationId id) const { return articulations_.IsValid(id); }
+  std::vector<BodyId> ArticulationLinks(ArticulationId id) const {
+    return articulations_.Links(id);
+  }
+  std::vector<JointState> GetJointStates(ArticulationId id) const {
+    return articulations_.GetJointStates(id);
+  }
   Status SetJointStates(ArticulationId id, const std::vector<double>& positions,
-                        const std::vector<double>& velocities);
-  Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command);
-  Status SetServoGains(ArticulationId id, const ServoGains& gains);
+                        const std::vector<double>& velocities) {
+    return articulations_.SetJointStates(id, positions, velocities);
+  }
+  Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command) {
+    return articulations_.SetJointCommand(id, joint, command);
+  }
+  Status SetServoGains(ArticulationId id, const ServoGains& gains) {
+    return articulations_.SetServoGains(id, gains);
+  }
 
  private:
   Body& MutableBody(BodyId id);
-  BodyId BodyIdOf(std::uint32_t index) const;
+  // LinkBodies, for the articulation system.
+  BodyId BodyIdOf(std::uint32_t index) const override;
+  void RestartContacts(std::uint32_t body) override;
   void Wake(std::uint32_t body);
   // Starts the body's sleep window again (it woke, was created or moved).
   void RestartSleepWindow(std::uint32_t body);
@@ -182,41 +162,8 @@ class WorldImpl {
   // `pairs` are the touching pairs, one per solver manifold.
   void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
   ContactReport MakeReport(const ShapePairContact& pair, int point,
-                           const std::array<Vec3, 2>& tangent, const StepContext& step) const;
-
-  // Articulations (world_articulations.cc, step_articulations.cc).
-  Status MoveArticulation(std::uint32_t index, const Pose& world_from_link,
-                          const Vec3& linear_velocity, const Vec3& angular_velocity, int link);
-  void PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart);
-  bool SkipsPair(const Body& a, const Body& b) const;
-  // Splits the touching pairs into those of rigid bodies only (the contact
-  // solver's) and those with a link (the articulation solve's).
-  void SplitLinkPairs(const std::vector<ShapePairContact*>& pairs);
-  void SolveArticulations(const StepContext& step);
-  int SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
-                        ArticulationKinematics* kinematics);
-  void RecordJointEfforts(const StepContext& step);
-  void TakeLinkSolveVelocities();
-  void AddArticulationRows(std::uint32_t index, int slot, const std::vector<JointRowSpec>& rows);
-  void CorrectLinkPenetration(const StepContext& step,
-                              const std::vector<int>& slot_of_articulation);
-  void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
-  // What a link-contact row's sides read: each articulation's solver slot
-  // and kinematics this step.
-  struct LinkRowContext {
-    const std::vector<int>* slot_of_articulation;
-    const std::vector<ArticulationKinematics>* kinematics;
-  };
-  void AddLinkContactRows(const StepContext& step, const std::vector<int>& slot_of_articulation,
-                          const std::vector<ArticulationKinematics>& kinematics);
-  int AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
-                       const ShapePairContact& pair, int i);
-  RowSide LinkContactSide(const LinkRowContext& context, std::uint32_t index, const Vec3& direction,
-                          const Vec3& point);
-  double StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
-                            std::uint32_t index, const Vec3& direction, const Vec3& point) const;
-  void ReportLinkContacts(const StepContext& step);
-  void MoveArticulations(const StepContext& step);
+                           const std::array<Vec3, 2>& tangent,
+                           const StepContext& step) const override;
 
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;      // settings_.threads threads
@@ -253,24 +200,8 @@ class WorldImpl {
   std::vector<BodyId> non_finite_bodies_;
   std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
   StepProfile last_step_profile_;
-  std::vector<ArticulationEntry> articulations_;
-  ArticulationSolver articulation_solver_;
-  ArticulatedBodyScratch articulation_scratch_;  // SolveArticulations'
-  std::vector<JointRowSpec> joint_row_scratch_;  // SetUpArticulation's
-  Eigen::VectorXd acceleration_scratch_;
-  std::vector<ShapePairContact*> rigid_pairs_;  // SplitLinkPairs'
-  std::vector<ShapePairContact*> link_pairs_;
-  // Per link pair, the index of its first normal row, or -1.
-  std::vector<int> link_pair_rows_;
-  // The normal rows of link contacts penetrating beyond the slop, each with
-  // the speed that removes position_correction of that depth in one step,
-  // and the solver of their split impulse (CorrectLinkPenetration).
-  std::vector<std::pair<int, double>> link_penetrations_;
-  std::vector<std::size_t> link_bouncing_rows_;  // scratch of BounceLinkContacts
-  // The rigid bodies' velocities of the link solve before its restitution
-  // pass, per body slot; empty when no point bounced this step.
-  std::vector<ArticulationSolver::BodySlot> link_solved_bodies_;
-  ArticulationSolver link_pseudo_solver_;
+  std::vector<ShapePairContact*> rigid_pairs_;  // the touching pairs without a link
+  ArticulationSystem articulations_{&bodies_, this};
 };
 
 }  // namespace rigid_body_sim::physics

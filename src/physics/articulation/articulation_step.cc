@@ -1,4 +1,4 @@
-// The articulations' part of stages 4 and 5 of WorldImpl::Step: their
+// The articulations' part of stages 4 and 5 of ArticulationSystem::Step: their
 // motion over the step in joint coordinates, and the rows of their contacts,
 // limits, servos, motors and joint friction, solved together
 // (docs/design.md, "Articulated bodies").
@@ -15,7 +15,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "physics/world/world_impl.h"
+#include "physics/articulation/articulation_system.h"
+#include "physics/contact/contact_frame.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -125,7 +126,7 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
 
 }  // namespace
 
-bool WorldImpl::SkipsPair(const Body& a, const Body& b) const {
+bool ArticulationSystem::SkipsPair(const Body& a, const Body& b) const {
   if (a.articulation < 0 || a.articulation != b.articulation) return false;
   const ArticulationModel& model = articulations_[a.articulation].model;
   if (!model.self_collide) return true;
@@ -136,31 +137,32 @@ bool WorldImpl::SkipsPair(const Body& a, const Body& b) const {
   return joined(a.link, b.link) || joined(b.link, a.link);
 }
 
-void WorldImpl::SplitLinkPairs(const std::vector<ShapePairContact*>& pairs) {
-  rigid_pairs_.clear();
+void ArticulationSystem::TakeLinkPairs(const std::vector<ShapePairContact*>& touching,
+                                       std::vector<ShapePairContact*>* rigid_pairs) {
+  rigid_pairs->clear();
   link_pairs_.clear();
-  for (ShapePairContact* pair : pairs) {
+  for (ShapePairContact* pair : touching) {
     const bool link =
         bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0;
-    (link ? link_pairs_ : rigid_pairs_).push_back(pair);
+    (link ? link_pairs_ : *rigid_pairs).push_back(pair);
   }
 }
 
-void WorldImpl::AddArticulationRows(std::uint32_t index, int slot,
-                                    const std::vector<JointRowSpec>& specs) {
+void ArticulationSystem::AddArticulationRows(std::uint32_t index, int slot,
+                                             const std::vector<JointRowSpec>& specs) {
   const int n = articulations_[index].model.DofCount();
   for (const JointRowSpec& spec : specs) {
     ConstraintRow row;
     row.articulation = static_cast<int>(index);
     row.joint = spec.joint;
     row.joint_sign = spec.sign;
-    row.a = articulation_solver_.ArticulationSide(slot, Unit(n, spec.column, spec.sign));
+    row.a = solver_.ArticulationSide(slot, Unit(n, spec.column, spec.sign));
     row.kind = spec.kind;
     row.target = spec.target;
     row.lower = -spec.bound;
     row.upper = spec.bound;
     row.softness = spec.softness;
-    articulation_solver_.AddRow(std::move(row));
+    solver_.AddRow(std::move(row));
   }
 }
 
@@ -170,9 +172,9 @@ void WorldImpl::AddArticulationRows(std::uint32_t index, int slot,
 // (a limit reached, a servo, friction, a contact) or stiff damping builds
 // its joint-space inertia M for the row solve, and only one with contacts
 // its links' Jacobians; the others take the free RK4 step.
-void WorldImpl::SolveArticulations(const StepContext& step) {
+void ArticulationSystem::Solve(const StepContext& step) {
   if (articulations_.empty()) return;
-  articulation_solver_.Reset();
+  solver_.Reset();
   std::vector<char> touched(articulations_.size(), 0);
   for (const ShapePairContact* pair : link_pairs_) {
     for (const std::uint32_t body : {pair->body_a, pair->body_b}) {
@@ -186,26 +188,25 @@ void WorldImpl::SolveArticulations(const StepContext& step) {
     slot[i] = SetUpArticulation(step, i, touched[i] != 0, &kinematics[i]);
   }
   AddLinkContactRows(step, slot, kinematics);
-  articulation_solver_.Solve(kMaxSweeps, kSweepTolerance);
+  solver_.Solve(kMaxSweeps, kSweepTolerance);
 
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     if (slot[i] < 0) continue;
     ArticulationEntry& entry = articulations_[i];
-    entry.next =
-        Advance(entry.model, entry.state, articulation_solver_.articulations()[slot[i]].u, step.dt);
+    entry.next = Advance(entry.model, entry.state, solver_.articulations()[slot[i]].u, step.dt);
   }
   BounceLinkContacts(slot);
   CorrectLinkPenetration(step, slot);
   RecordJointEfforts(step);
-  TakeLinkSolveVelocities();
+  TakeLinkSolveVelocities(step);
 }
 
 // Articulation `index`'s free motion, u* = u + dt u' by the ABA. Without
 // rows, contacts or stiff damping it takes its free RK4 step at once (and
 // gets no solver slot, -1); otherwise it joins the row solve with M + dt B
 // and its joint rows, and its solver slot is returned.
-int WorldImpl::SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
-                                 ArticulationKinematics* kinematics) {
+int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t index,
+                                          bool touched, ArticulationKinematics* kinematics) {
   ArticulationEntry& entry = articulations_[index];
   ArticulationModel& model = entry.model;
   std::vector<JointRowSpec>& joint_rows = joint_row_scratch_;
@@ -219,8 +220,8 @@ int WorldImpl::SetUpArticulation(const StepContext& step, std::uint32_t index, b
   ComputeKinematics(
       model, entry.state, &k,
       touched ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
-  ForwardDynamics({model, entry.state, k, settings_.gravity, efforts, step.dt},
-                  &articulation_scratch_, &acceleration);
+  ForwardDynamics({model, entry.state, k, step.settings->gravity, efforts, step.dt}, &scratch_,
+                  &acceleration);
   const Eigen::VectorXd u_free = entry.state.u + step.dt * acceleration;
   JointRowsOf(entry, u_free, step.dt, entry.gains, &joint_rows);
   for (ArticulationJoint& joint : model.joints) {
@@ -230,9 +231,9 @@ int WorldImpl::SetUpArticulation(const StepContext& step, std::uint32_t index, b
     // Without damping, u* came from the explicit dynamics: the first
     // RK4 stage's u'.
     const bool damped = AnyJointDamped(model);
-    entry.next = StepFreeMotionBalanced(
-        {model, entry.state, settings_.gravity, efforts, step.dt, damped ? nullptr : &acceleration},
-        &entry.free_motion_split);
+    entry.next = StepFreeMotionBalanced({model, entry.state, step.settings->gravity, efforts,
+                                         step.dt, damped ? nullptr : &acceleration},
+                                        &entry.free_motion_split);
     return -1;
   }
   Eigen::MatrixXd mass;
@@ -241,15 +242,15 @@ int WorldImpl::SetUpArticulation(const StepContext& step, std::uint32_t index, b
     if (joint.dof >= 0)
       mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += step.dt * joint.def.damping;
   }
-  const int slot = articulation_solver_.AddArticulation(u_free, mass);
+  const int slot = solver_.AddArticulation(u_free, mass);
   AddArticulationRows(index, slot, joint_rows);
   return slot;
 }
 
-void WorldImpl::RecordJointEfforts(const StepContext& step) {
+void ArticulationSystem::RecordJointEfforts(const StepContext& step) {
   // A joint's effort: its command's, its rows' impulses over dt, less its
   // damping; shared with its mimics, each taking its multiplier's part.
-  for (const ConstraintRow& row : articulation_solver_.rows()) {
+  for (const ConstraintRow& row : solver_.rows()) {
     if (row.joint < 0) continue;
     ArticulationEntry& entry = articulations_[row.articulation];
     entry.model.joints[row.joint].effort += row.joint_sign * row.impulse / step.dt;
@@ -269,8 +270,8 @@ void WorldImpl::RecordJointEfforts(const StepContext& step) {
 }
 
 // The rigid bodies that touched links take the link solve's velocities.
-void WorldImpl::TakeLinkSolveVelocities() {
-  const std::vector<ArticulationSolver::BodySlot>& slots = articulation_solver_.bodies();
+void ArticulationSystem::TakeLinkSolveVelocities(const StepContext& step) {
+  const std::vector<ArticulationSolver::BodySlot>& slots = solver_.bodies();
   for (std::size_t index = 0; index < slots.size(); ++index) {
     const ArticulationSolver::BodySlot& slot_body = slots[index];
     Body& body = bodies_[slot_body.body];
@@ -278,7 +279,7 @@ void WorldImpl::TakeLinkSolveVelocities() {
       continue;
     // The velocities of the solve, before any restitution pass.
     const ArticulationSolver::BodySlot& solved =
-        link_solved_bodies_.empty() ? slot_body : link_solved_bodies_[index];
+        solved_bodies_.empty() ? slot_body : solved_bodies_[index];
     const Mat3 rotation = body.orientation.toRotationMatrix();
     auto momentum = [&](const Vec3& angular_velocity) -> Vec3 {
       return rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
@@ -292,8 +293,8 @@ void WorldImpl::TakeLinkSolveVelocities() {
     // the trapezoidal drift keeps it exact, as kinetic friction on a
     // lifted box. A larger one stops an impact, an impulse at the start of
     // the step whose whole change drifts.
-    const double resting = settings_.solver.collision_velocity_threshold +
-                           settings_.time_step * settings_.gravity.norm();
+    const double resting = step.settings->solver.collision_velocity_threshold +
+                           step.settings->time_step * step.settings->gravity.norm();
     if (linear_change.norm() > resting) {
       body.start_linear_velocity += linear_change;
       body.start_angular_momentum += solved_momentum - body.angular_momentum;
@@ -312,9 +313,9 @@ void WorldImpl::TakeLinkSolveVelocities() {
 // d . (velocity of the body's point at `point`) before this step's forces:
 // a link's from the joint-space velocity the step starts with, a rigid
 // body's from the momenta IntegrateForces started from.
-double WorldImpl::StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
-                                     std::uint32_t index, const Vec3& direction,
-                                     const Vec3& point) const {
+double ArticulationSystem::StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
+                                              std::uint32_t index, const Vec3& direction,
+                                              const Vec3& point) const {
   const Body& body = bodies_[index];
   const Vec3 r = point - body.position;
   if (body.articulation >= 0) {
@@ -332,8 +333,8 @@ double WorldImpl::StartPointVelocity(const std::vector<ArticulationKinematics>& 
 // One side of a link-contact row along `direction` at `point`: a link's
 // through its Jacobian (J_v^T d + J_w^T (r x d)), a rigid body's through
 // its mass and inertia (a static or resting one has none).
-RowSide WorldImpl::LinkContactSide(const LinkRowContext& context, std::uint32_t index,
-                                   const Vec3& direction, const Vec3& point) {
+RowSide ArticulationSystem::LinkContactSide(const LinkRowContext& context, std::uint32_t index,
+                                            const Vec3& direction, const Vec3& point) {
   const Body& body = bodies_[index];
   if (body.articulation >= 0) {
     const int articulation_slot = (*context.slot_of_articulation)[body.articulation];
@@ -341,7 +342,7 @@ RowSide WorldImpl::LinkContactSide(const LinkRowContext& context, std::uint32_t 
     const Vec3 r = point - body.position;
     const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
                                 jacobian.bottomRows<3>().transpose() * r.cross(direction);
-    return articulation_solver_.ArticulationSide(articulation_slot, row);
+    return solver_.ArticulationSide(articulation_slot, row);
   }
   ArticulationSolver::BodySlot body_slot;
   body_slot.body = index;
@@ -352,8 +353,7 @@ RowSide WorldImpl::LinkContactSide(const LinkRowContext& context, std::uint32_t 
     body_slot.inverse_mass = body.inverse_mass;
     body_slot.inverse_inertia_world = body.inverse_inertia_world;
   }
-  return articulation_solver_.BodySide(articulation_solver_.BodySlotOf(body_slot), direction,
-                                       point - body.position);
+  return solver_.BodySide(solver_.BodySlotOf(body_slot), direction, point - body.position);
 }
 
 // Per point of a pair with a link: a normal row and two friction rows. The
@@ -367,9 +367,9 @@ RowSide WorldImpl::LinkContactSide(const LinkRowContext& context, std::uint32_t 
 // 1997, "Rigid Body Simulation II", section 8): a link resting on the
 // ground closes at g dt by the end of the free step, above the collision
 // threshold, and with e > 0 it would hop every step.
-void WorldImpl::AddLinkContactRows(const StepContext& step,
-                                   const std::vector<int>& slot_of_articulation,
-                                   const std::vector<ArticulationKinematics>& kinematics) {
+void ArticulationSystem::AddLinkContactRows(const StepContext& step,
+                                            const std::vector<int>& slot_of_articulation,
+                                            const std::vector<ArticulationKinematics>& kinematics) {
   const LinkRowContext context{&slot_of_articulation, &kinematics};
   link_pair_rows_.assign(link_pairs_.size(), -1);
   link_penetrations_.clear();
@@ -384,9 +384,9 @@ void WorldImpl::AddLinkContactRows(const StepContext& step,
 
 // Point `i` of a link pair: its normal row (classified as above) and two
 // friction rows; returns the normal row's index.
-int WorldImpl::AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
-                                const ShapePairContact& pair, int i) {
-  const SolverSettings& solver = settings_.solver;
+int ArticulationSystem::AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+                                         const ShapePairContact& pair, int i) {
+  const SolverSettings& solver = step.settings->solver;
   const Body& a = bodies_[pair.body_a];
   const Body& b = bodies_[pair.body_b];
   const Material& material_a = a.shapes[pair.shape_a].material;
@@ -417,7 +417,7 @@ int WorldImpl::AddLinkPointRows(const StepContext& step, const LinkRowContext& c
   }
   const double depth = -separation - solver.penetration_slop;
   normal_row.impulse = pair.warm_start[i].normal_impulse;
-  const int normal_index = articulation_solver_.AddRow(std::move(normal_row));
+  const int normal_index = solver_.AddRow(std::move(normal_row));
   if (depth > 0.0) {
     link_penetrations_.emplace_back(normal_index, solver.position_correction * depth / step.dt);
   }
@@ -429,7 +429,7 @@ int WorldImpl::AddLinkPointRows(const StepContext& step, const LinkRowContext& c
     tangent_row.normal_row = normal_index;
     tangent_row.friction = friction;
     tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
-    articulation_solver_.AddRow(std::move(tangent_row));
+    solver_.AddRow(std::move(tangent_row));
   }
   return normal_index;
 }
@@ -444,11 +444,11 @@ int WorldImpl::AddLinkPointRows(const StepContext& step, const LinkRowContext& c
 // v3.0, Catto 2024, contact_solver.c). The body ends the step at the
 // contact, moving off at e |v-|, up to one step late against the exact
 // rise.
-void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation) {
-  std::vector<std::size_t>& bouncing = link_bouncing_rows_;
+void ArticulationSystem::BounceLinkContacts(const std::vector<int>& slot_of_articulation) {
+  std::vector<std::size_t>& bouncing = bouncing_rows_;
   bouncing.clear();
-  link_solved_bodies_.clear();
-  std::vector<ConstraintRow>& rows = articulation_solver_.rows();
+  solved_bodies_.clear();
+  std::vector<ConstraintRow>& rows = solver_.rows();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     ConstraintRow& row = rows[k];
     if (row.bounce <= 0.0 || row.impulse <= 0.0) continue;
@@ -457,11 +457,11 @@ void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation)
     bouncing.push_back(k);
   }
   if (bouncing.empty()) return;
-  link_solved_bodies_ = articulation_solver_.bodies();
-  articulation_solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
+  solved_bodies_ = solver_.bodies();
+  solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     const int slot = slot_of_articulation[i];
-    if (slot >= 0) articulations_[i].next.u = articulation_solver_.articulations()[slot].u;
+    if (slot >= 0) articulations_[i].next.u = solver_.articulations()[slot].u;
   }
 }
 
@@ -476,14 +476,13 @@ void WorldImpl::BounceLinkContacts(const std::vector<int>& slot_of_articulation)
 // chain, feed it. The split impulse of Bullet's sequential-impulse solver
 // (btSequentialImpulseConstraintSolver), in joint coordinates; the
 // projected Gauss-Seidel is Erleben 2007, section 3.
-void WorldImpl::CorrectLinkPenetration(const StepContext& step,
-                                       const std::vector<int>& slot_of_articulation) {
+void ArticulationSystem::CorrectLinkPenetration(const StepContext& step,
+                                                const std::vector<int>& slot_of_articulation) {
   if (link_penetrations_.empty()) return;
-  ArticulationSolver& pseudo = link_pseudo_solver_;
+  ArticulationSolver& pseudo = pseudo_solver_;
   pseudo.Reset();
-  const std::vector<ArticulationSolver::ArticulationSlot>& velocity_slots =
-      articulation_solver_.articulations();
-  const std::vector<ArticulationSolver::BodySlot>& velocity_bodies = articulation_solver_.bodies();
+  const std::vector<ArticulationSolver::ArticulationSlot>& velocity_slots = solver_.articulations();
+  const std::vector<ArticulationSolver::BodySlot>& velocity_bodies = solver_.bodies();
   std::vector<int> pseudo_slot(velocity_slots.size(), -1);
   auto remap = [&](RowSide side) {
     if (side.kind == RowSide::Kind::kArticulation) {
@@ -503,7 +502,7 @@ void WorldImpl::CorrectLinkPenetration(const StepContext& step,
     return side;
   };
   for (const auto& [index, target] : link_penetrations_) {
-    const ConstraintRow& from = articulation_solver_.rows()[index];
+    const ConstraintRow& from = solver_.rows()[index];
     ConstraintRow row;
     row.kind = RowKind::kNormal;
     row.a = remap(from.a);
@@ -515,7 +514,7 @@ void WorldImpl::CorrectLinkPenetration(const StepContext& step,
   // friction, mimics) hold in the correction as in the velocity solve:
   // pushing a box out of a link may turn a joint only as far as a push on
   // it could, not freely past the motor that holds it.
-  for (const ConstraintRow& from : articulation_solver_.rows()) {
+  for (const ConstraintRow& from : solver_.rows()) {
     if (from.articulation < 0 || from.a.kind != RowSide::Kind::kArticulation ||
         pseudo_slot[from.a.slot] < 0) {
       continue;
@@ -550,8 +549,10 @@ void WorldImpl::CorrectLinkPenetration(const StepContext& step,
 
 // Keeps the link pairs' impulses for next step's warm start and reports
 // their points, as ReportContacts does for the rigid pairs.
-void WorldImpl::ReportLinkContacts(const StepContext& step) {
-  const std::vector<ConstraintRow>& rows = articulation_solver_.rows();
+void ArticulationSystem::ReportContacts(const StepContext& step,
+                                        std::vector<ContactReport>* contacts,
+                                        std::vector<ContactReport>* collision_log) {
+  const std::vector<ConstraintRow>& rows = solver_.rows();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
     ShapePairContact& pair = *link_pairs_[m];
     const int first = link_pair_rows_[m];
@@ -566,12 +567,12 @@ void WorldImpl::ReportLinkContacts(const StepContext& step) {
                         normal.impulse,
                         {rows[first + 3 * i + 1].impulse, rows[first + 3 * i + 2].impulse},
                         point.position_world};
-      const bool touching = point.separation <= settings_.solver.contact_tolerance;
+      const bool touching = point.separation <= step.settings->solver.contact_tolerance;
       if (!touching && normal.impulse <= 0.0) continue;
-      ContactReport& report = contacts_.emplace_back(MakeReport(pair, i, tangent, step));
+      ContactReport& report = contacts->emplace_back(world_.MakeReport(pair, i, tangent, step));
       const bool colliding = normal.colliding && normal.impulse > 0.0;
       report.type = colliding ? ContactType::kColliding : ContactType::kResting;
-      if (colliding) collision_log_.push_back(report);
+      if (colliding) collision_log->push_back(report);
     }
   }
 }
@@ -579,7 +580,7 @@ void WorldImpl::ReportLinkContacts(const StepContext& step) {
 // Stage 5 for the articulations: each takes the state its solve chose, and
 // its links follow. A state that is not finite (forces that overflowed) is
 // refused: the articulation stays where it was, at rest.
-void WorldImpl::MoveArticulations(const StepContext& /*step*/) {
+void ArticulationSystem::Move() {
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     ArticulationEntry& entry = articulations_[i];
     if (!entry.in_use) continue;

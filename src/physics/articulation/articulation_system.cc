@@ -1,9 +1,12 @@
 // Articulations in the world: creation with its checks, joint state and
 // commands, and moving a whole articulation when one of its links is set.
+#include "physics/articulation/articulation_system.h"
+
 #include <cmath>
+#include <limits>
 #include <string>
 
-#include "physics/world/world_impl.h"
+#include "physics/dynamics/body_state.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -126,7 +129,10 @@ ArticulationModel MakeModel(const ArticulationDef& def) {
 
 }  // namespace
 
-Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def) {
+ArticulationSystem::ArticulationSystem(std::vector<Body>* bodies, LinkBodies* world)
+    : bodies_(*bodies), world_(*world) {}
+
+Result<ArticulationId> ArticulationSystem::Create(const ArticulationDef& def) {
   if (Status status = ValidateArticulation(def); !status.ok()) return status;
   if (Status status =
           ValidateState(def.world_from_base, def.base_linear_velocity, def.base_angular_velocity);
@@ -169,10 +175,10 @@ Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def)
     body_def.mass_properties = def.links[i].mass_properties;
     body_def.shapes = def.links[i].shapes;
     body_def.user_data = def.user_data;
-    Result<BodyId> body = CreateBody(body_def);
+    Result<BodyId> body = world_.CreateBody(body_def);
     if (!body.ok()) {
       for (std::size_t made = 0; made < i; ++made)
-        DestroyBody(BodyIdOf(entry.model.links[made].body));
+        world_.DestroyBody(world_.BodyIdOf(entry.model.links[made].body));
       return Status::Error("link " + std::to_string(i) + " ('" + def.links[i].name +
                            "'): " + body.status().message());
     }
@@ -186,16 +192,12 @@ Result<ArticulationId> WorldImpl::CreateArticulation(const ArticulationDef& def)
   return ArticulationId{index, articulations_[index].generation};
 }
 
-BodyId WorldImpl::BodyIdOf(std::uint32_t index) const {
-  return BodyId{index, bodies_[index].generation};
-}
-
-Status WorldImpl::DestroyArticulation(ArticulationId id) {
+Status ArticulationSystem::Destroy(ArticulationId id) {
   if (!IsValid(id)) return Status::Error("no articulation with this id");
   ArticulationEntry& entry = articulations_[id.index];
   for (const ArticulationLink& link : entry.model.links) {
     bodies_[link.body].articulation = -1;
-    DestroyBody(BodyIdOf(link.body));
+    world_.DestroyBody(world_.BodyIdOf(link.body));
   }
   const std::uint32_t next_generation = entry.generation + 1;
   entry = ArticulationEntry();
@@ -203,21 +205,21 @@ Status WorldImpl::DestroyArticulation(ArticulationId id) {
   return Status::Ok();
 }
 
-bool WorldImpl::IsValid(ArticulationId id) const {
+bool ArticulationSystem::IsValid(ArticulationId id) const {
   return id.index < articulations_.size() && articulations_[id.index].in_use &&
          articulations_[id.index].generation == id.generation;
 }
 
-std::vector<BodyId> WorldImpl::ArticulationLinks(ArticulationId id) const {
+std::vector<BodyId> ArticulationSystem::Links(ArticulationId id) const {
   std::vector<BodyId> links;
   if (!IsValid(id)) return links;
   for (const ArticulationLink& link : articulations_[id.index].model.links) {
-    links.push_back(BodyIdOf(link.body));
+    links.push_back(world_.BodyIdOf(link.body));
   }
   return links;
 }
 
-std::vector<JointState> WorldImpl::GetJointStates(ArticulationId id) const {
+std::vector<JointState> ArticulationSystem::GetJointStates(ArticulationId id) const {
   std::vector<JointState> states;
   if (!IsValid(id)) return states;
   const ArticulationEntry& entry = articulations_[id.index];
@@ -232,8 +234,8 @@ std::vector<JointState> WorldImpl::GetJointStates(ArticulationId id) const {
 
 // Positions and velocities of every joint, in joint order; a mimic joint's
 // entries are ignored. A position that changes must lie within its limits.
-Status WorldImpl::SetJointStates(ArticulationId id, const std::vector<double>& positions,
-                                 const std::vector<double>& velocities) {
+Status ArticulationSystem::SetJointStates(ArticulationId id, const std::vector<double>& positions,
+                                          const std::vector<double>& velocities) {
   if (!IsValid(id)) return Status::Error("no articulation with this id");
   ArticulationEntry& entry = articulations_[id.index];
   const std::size_t count = entry.model.joints.size();
@@ -269,7 +271,8 @@ Status WorldImpl::SetJointStates(ArticulationId id, const std::vector<double>& p
   return Status::Ok();
 }
 
-Status WorldImpl::SetJointCommand(ArticulationId id, int joint, const JointCommand& command) {
+Status ArticulationSystem::SetJointCommand(ArticulationId id, int joint,
+                                           const JointCommand& command) {
   if (!IsValid(id)) return Status::Error("no articulation with this id");
   ArticulationEntry& entry = articulations_[id.index];
   if (joint < 0 || joint >= static_cast<int>(entry.model.joints.size())) {
@@ -289,7 +292,7 @@ Status WorldImpl::SetJointCommand(ArticulationId id, int joint, const JointComma
   return Status::Ok();
 }
 
-Status WorldImpl::SetServoGains(ArticulationId id, const ServoGains& gains) {
+Status ArticulationSystem::SetServoGains(ArticulationId id, const ServoGains& gains) {
   if (!IsValid(id)) return Status::Error("no articulation with this id");
   if (!(gains.stiffness > 0.0) || !std::isfinite(gains.stiffness) || !(gains.damping >= 0.0) ||
       !std::isfinite(gains.damping)) {
@@ -305,9 +308,9 @@ Status WorldImpl::SetServoGains(ArticulationId id, const ServoGains& gains) {
 // the base goes where it keeps its pose relative to that link, the joints
 // keep their positions and stop, and a floating base takes the twist that
 // gives the link the velocity asked for.
-Status WorldImpl::MoveArticulation(std::uint32_t index, const Pose& world_from_link,
-                                   const Vec3& linear_velocity, const Vec3& angular_velocity,
-                                   int link) {
+Status ArticulationSystem::MoveWithLink(std::uint32_t index, const Pose& world_from_link,
+                                        const Vec3& linear_velocity, const Vec3& angular_velocity,
+                                        int link) {
   ArticulationEntry& entry = articulations_[index];
   ArticulationKinematics k;
   ComputeKinematics(entry.model, entry.state, &k, KinematicsParts::kPosesAndVelocities);
@@ -330,7 +333,8 @@ Status WorldImpl::MoveArticulation(std::uint32_t index, const Pose& world_from_l
 
 // Puts every link body where the state says, with its velocity. A restart
 // (a teleport) also forgets the links' contacts and wakes what touched them.
-void WorldImpl::PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart) {
+void ArticulationSystem::PlaceLinks(std::uint32_t index, const ArticulationState& state,
+                                    bool restart) {
   const ArticulationEntry& entry = articulations_[index];
   ArticulationKinematics k;
   ComputeKinematics(entry.model, state, &k, KinematicsParts::kPosesAndVelocities);
@@ -347,10 +351,7 @@ void WorldImpl::PlaceLinks(std::uint32_t index, const ArticulationState& state, 
     // The narrow phase skips pairs by how far their bodies travelled.
     body.travel += (body.position - start_com).norm() +
                    start_rotation.angularDistance(body.orientation) * body.bounding_radius;
-    if (restart) {
-      WakeTouching(body_index);
-      contact_cache_.RemoveBody(body_index);
-    }
+    if (restart) world_.RestartContacts(body_index);
   }
 }
 

@@ -1,0 +1,152 @@
+// The articulations of a world as one system: their models and states,
+// their commands and servo gains, the touching pairs that involve a link,
+// and their part of the step (the joint-space solve of stage 4 and the move
+// of stage 5). The world owns the link bodies and orders the stages; the
+// system reaches the world only through LinkBodies.
+#ifndef RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SYSTEM_H_
+#define RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SYSTEM_H_
+
+#include <array>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "physics/articulation/articulation_dynamics.h"
+#include "physics/articulation/articulation_solver.h"
+#include "physics/contact/contact_cache.h"
+#include "physics/world/step_context.h"
+#include "rigid_body_sim/physics/articulation.h"
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/result.h"
+
+namespace rigid_body_sim::physics {
+
+// What the articulation system needs of the world that holds its link
+// bodies (WorldImpl implements it).
+class LinkBodies {
+ public:
+  virtual Result<BodyId> CreateBody(const BodyDef& def) = 0;
+  virtual Status DestroyBody(BodyId id) = 0;
+  virtual BodyId BodyIdOf(std::uint32_t index) const = 0;
+  // The body was teleported: what touched it wakes, its contacts are forgotten.
+  virtual void RestartContacts(std::uint32_t body) = 0;
+  virtual ContactReport MakeReport(const ShapePairContact& pair, int point,
+                                   const std::array<Vec3, 2>& tangent,
+                                   const StepContext& step) const = 0;
+
+ protected:
+  ~LinkBodies() = default;
+};
+
+// One joint row before it has a solver slot: the row on its dof `column`
+// (sign: +1 pushes the joint forward), as ConstraintRow's fields.
+struct JointRowSpec {
+  int joint = -1;
+  int column = 0;
+  double sign = 1.0;
+  RowKind kind = RowKind::kBounded;
+  double target = 0.0;  // velocity units of the row
+  double bound = 0.0;   // |impulse| <= bound (kBounded)
+  double softness = 0.0;
+};
+
+// An articulation in the world: its model, its state, and the state its
+// constraint solve chose for the end of the step.
+struct ArticulationEntry {
+  ArticulationModel model;
+  ArticulationState state;
+  ArticulationState next;
+  ServoGains gains;
+  FreeMotionSplit free_motion_split;
+  bool in_use = false;
+  std::uint32_t generation = 0;
+};
+
+class ArticulationSystem {
+ public:
+  // `bodies` is the world's body slots, which the links are among.
+  ArticulationSystem(std::vector<Body>* bodies, LinkBodies* world);
+
+  // The public methods do what World's of the same name are documented to
+  // do (articulation_system.cc).
+  Result<ArticulationId> Create(const ArticulationDef& def);
+  Status Destroy(ArticulationId id);
+  bool IsValid(ArticulationId id) const;
+  std::vector<BodyId> Links(ArticulationId id) const;
+  std::vector<JointState> GetJointStates(ArticulationId id) const;
+  Status SetJointStates(ArticulationId id, const std::vector<double>& positions,
+                        const std::vector<double>& velocities);
+  Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command);
+  Status SetServoGains(ArticulationId id, const ServoGains& gains);
+  // Moves articulation `index` rigidly so that its link `link` takes this
+  // pose and twist (World::SetState on a link).
+  Status MoveWithLink(std::uint32_t index, const Pose& world_from_link, const Vec3& linear_velocity,
+                      const Vec3& angular_velocity, int link);
+  // Two links of one articulation that are not to collide.
+  bool SkipsPair(const Body& a, const Body& b) const;
+
+  // The step (articulation_step.cc). Stage 4: the touching pairs split into
+  // the rigid bodies' (`rigid_pairs`, the contact solver's) and those with a
+  // link (kept here), then one solve of the articulations with their rows.
+  void TakeLinkPairs(const std::vector<ShapePairContact*>& touching,
+                     std::vector<ShapePairContact*>* rigid_pairs);
+  const std::vector<ShapePairContact*>& link_pairs() const { return link_pairs_; }
+  void Solve(const StepContext& step);
+  // Keeps the link pairs' impulses for the next warm start and reports
+  // their points.
+  void ReportContacts(const StepContext& step, std::vector<ContactReport>* contacts,
+                      std::vector<ContactReport>* collision_log);
+  // Stage 5: each articulation takes the state its solve chose, and its
+  // links follow.
+  void Move();
+
+ private:
+  void PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart);
+  int SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
+                        ArticulationKinematics* kinematics);
+  void AddArticulationRows(std::uint32_t index, int slot, const std::vector<JointRowSpec>& rows);
+  // What a link-contact row's sides read: each articulation's solver slot
+  // and kinematics this step.
+  struct LinkRowContext {
+    const std::vector<int>* slot_of_articulation;
+    const std::vector<ArticulationKinematics>* kinematics;
+  };
+  void AddLinkContactRows(const StepContext& step, const std::vector<int>& slot_of_articulation,
+                          const std::vector<ArticulationKinematics>& kinematics);
+  int AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+                       const ShapePairContact& pair, int i);
+  RowSide LinkContactSide(const LinkRowContext& context, std::uint32_t index, const Vec3& direction,
+                          const Vec3& point);
+  double StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
+                            std::uint32_t index, const Vec3& direction, const Vec3& point) const;
+  void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
+  void CorrectLinkPenetration(const StepContext& step,
+                              const std::vector<int>& slot_of_articulation);
+  void RecordJointEfforts(const StepContext& step);
+  void TakeLinkSolveVelocities(const StepContext& step);
+
+  std::vector<Body>& bodies_;
+  LinkBodies& world_;
+  std::vector<ArticulationEntry> articulations_;
+  ArticulationSolver solver_;
+  ArticulatedBodyScratch scratch_;               // SetUpArticulation's
+  std::vector<JointRowSpec> joint_row_scratch_;  // SetUpArticulation's
+  Eigen::VectorXd acceleration_scratch_;
+  std::vector<ShapePairContact*> link_pairs_;  // TakeLinkPairs'
+  // Per link pair, the index of its first normal row, or -1.
+  std::vector<int> link_pair_rows_;
+  // The normal rows of link contacts penetrating beyond the slop, each with
+  // the speed that removes position_correction of that depth in one step,
+  // and the solver of their split impulse (CorrectLinkPenetration).
+  std::vector<std::pair<int, double>> link_penetrations_;
+  std::vector<std::size_t> bouncing_rows_;  // scratch of BounceLinkContacts
+  // The rigid bodies' velocities of the link solve before its restitution
+  // pass, per body slot; empty when no point bounced this step.
+  std::vector<ArticulationSolver::BodySlot> solved_bodies_;
+  ArticulationSolver pseudo_solver_;
+};
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SYSTEM_H_
