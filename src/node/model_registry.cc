@@ -79,14 +79,12 @@ Result<BodyDef> MakeBodyDef(const io::LoadedModel& model, const ModelSpec& spec,
 
 Result<physics::ArticulationDef> MakeArticulationSpec(const io::LoadedModel& model,
                                                       const ModelSpec& spec,
-                                                      const MaterialDefaults& defaults,
+                                                      const physics::BodyDef& body_def,
                                                       std::vector<std::string>* warnings) {
-  // The materials as a rigid body of the same model would have them.
-  Result<BodyDef> rigid = MakeBodyDef(model, spec, defaults);
-  if (!rigid.ok()) return rigid.status();
+  // The materials as the rigid body of the same model has them.
   io::LoadedModel with_materials = model;
   for (std::size_t i = 0; i < model.shapes.size(); ++i) {
-    with_materials.shapes[i].shape.material = rigid->shapes[i].material;
+    with_materials.shapes[i].shape.material = body_def.shapes[i].material;
   }
   Result<physics::ArticulationDef> made = io::MakeArticulationDef(with_materials, warnings);
   if (!made.ok()) return made;

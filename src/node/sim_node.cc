@@ -340,7 +340,7 @@ Result<SimNode::PreparedModel> SimNode::PrepareModel(const ModelSpec& spec,
   prepared.def = std::move(def).value();
   if (loaded->articulated) {
     Result<physics::ArticulationDef> made =
-        MakeArticulationSpec(*loaded, spec, defaults, &prepared.warnings);
+        MakeArticulationSpec(*loaded, spec, prepared.def, &prepared.warnings);
     if (!made.ok()) return made.status();
     prepared.articulation = std::move(made).value();
   }

@@ -86,11 +86,11 @@ physics::Result<physics::BodyDef> MakeBodyDef(const io::LoadedModel& model, cons
                                               const MaterialDefaults& defaults);
 
 // The articulation of an articulated model placed as the spec asks, with
-// the materials MakeBodyDef would give its shapes; `warnings` gets the
-// loader's notes on links without mass.
+// the materials of `body_def` (MakeBodyDef's for the same model and spec)
+// on its shapes; `warnings` gets the loader's notes on links without mass.
 physics::Result<physics::ArticulationDef> MakeArticulationSpec(const io::LoadedModel& model,
                                                                const ModelSpec& spec,
-                                                               const MaterialDefaults& defaults,
+                                                               const physics::BodyDef& body_def,
                                                                std::vector<std::string>* warnings);
 
 // Rigid-body velocity transfer between two frames of one body:

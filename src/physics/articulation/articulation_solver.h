@@ -66,6 +66,7 @@ struct ConstraintRow {
   // faster than the collision threshold: -e v-, the v+ it leaves with once
   // its row has stopped it (impulse > 0). 0: no bounce.
   double bounce = 0.0;
+  double restitution = 0.0;  // kNormal of a contact point: e of its materials
   // A joint's own row (limit, servo, motor, friction): whose, and the sign
   // its impulse has as the joint's effort.
   int articulation = -1;

@@ -86,7 +86,7 @@ class ArticulationSystem {
   // Two links of one articulation that are not to collide.
   bool SkipsPair(const Body& a, const Body& b) const;
 
-  // The step (articulation_step.cc). Stage 4: the touching pairs split into
+  // The step (articulation_step.cc, link_contacts.cc). Stage 4: the touching pairs split into
   // the rigid bodies' (`rigid_pairs`, the contact solver's) and those with a
   // link (kept here), then one solve of the articulations with their rows.
   void TakeLinkPairs(const std::vector<ShapePairContact*>& touching,
@@ -102,6 +102,10 @@ class ArticulationSystem {
   void Move();
 
  private:
+  // The row solves' limits (projected Gauss-Seidel).
+  static constexpr int kMaxSweeps = 200;
+  static constexpr double kSweepTolerance = 1e-9;
+
   void PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart);
   int SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
                         ArticulationKinematics* kinematics);
@@ -120,7 +124,9 @@ class ArticulationSystem {
                           const Vec3& point);
   double StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
                             std::uint32_t index, const Vec3& direction, const Vec3& point) const;
-  void BounceLinkContacts(const std::vector<int>& slot_of_articulation);
+  void BounceLinkContacts(const StepContext& step, const std::vector<int>& slot_of_articulation);
+  std::vector<double> LinkImpactTimes(const StepContext& step,
+                                      const std::vector<int>& slot_of_articulation);
   void CorrectLinkPenetration(const StepContext& step,
                               const std::vector<int>& slot_of_articulation);
   void RecordJointEfforts(const StepContext& step);
@@ -141,6 +147,9 @@ class ArticulationSystem {
   // and the solver of their split impulse (CorrectLinkPenetration).
   std::vector<std::pair<int, double>> link_penetrations_;
   std::vector<std::size_t> bouncing_rows_;  // scratch of BounceLinkContacts
+  // Per articulation slot, its velocity before the bouncing points'
+  // impulses (LinkImpactTimes).
+  std::vector<Eigen::VectorXd> approach_velocities_;
   // The rigid bodies' velocities of the link solve before its restitution
   // pass, per body slot; empty when no point bounced this step.
   std::vector<ArticulationSolver::BodySlot> solved_bodies_;

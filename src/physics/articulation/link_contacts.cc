@@ -1,0 +1,359 @@
+// The contacts of links: their rows in the articulations' solve, their
+// restitution at the time they touch, the split impulse that lifts a link
+// out of what it penetrates, and their reports (docs/design.md,
+// "Articulated bodies").
+#include <algorithm>
+#include <array>
+
+#include "physics/articulation/articulation_system.h"
+#include "physics/contact/contact_frame.h"
+
+namespace rigid_body_sim::physics {
+
+// d . (velocity of the body's point at `point`) before this step's forces:
+// a link's from the joint-space velocity the step starts with, a rigid
+// body's from the momenta IntegrateForces started from.
+double ArticulationSystem::StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
+                                              std::uint32_t index, const Vec3& direction,
+                                              const Vec3& point) const {
+  const Body& body = bodies_[index];
+  const Vec3 r = point - body.position;
+  if (body.articulation >= 0) {
+    const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
+    const Eigen::VectorXd& u = articulations_[body.articulation].state.u;
+    const Vec3 linear = jacobian.topRows<3>() * u;
+    const Vec3 angular = jacobian.bottomRows<3>() * u;
+    return direction.dot(linear + angular.cross(r));
+  }
+  if (body.is_static || !body.awake || body.disabled) return 0.0;
+  const Vec3 angular = body.inverse_inertia_world * body.start_angular_momentum;
+  return direction.dot(body.start_linear_velocity + angular.cross(r));
+}
+
+// One side of a link-contact row along `direction` at `point`: a link's
+// through its Jacobian (J_v^T d + J_w^T (r x d)), a rigid body's through
+// its mass and inertia (a static or resting one has none).
+RowSide ArticulationSystem::LinkContactSide(const LinkRowContext& context, std::uint32_t index,
+                                            const Vec3& direction, const Vec3& point) {
+  const Body& body = bodies_[index];
+  if (body.articulation >= 0) {
+    const int articulation_slot = (*context.slot_of_articulation)[body.articulation];
+    const JacobianRows& jacobian = (*context.kinematics)[body.articulation].jacobian[body.link];
+    const Vec3 r = point - body.position;
+    const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
+                                jacobian.bottomRows<3>().transpose() * r.cross(direction);
+    return solver_.ArticulationSide(articulation_slot, row);
+  }
+  ArticulationSolver::BodySlot body_slot;
+  body_slot.body = index;
+  const bool moves = !body.is_static && body.awake && !body.disabled;
+  if (moves) {
+    body_slot.linear_velocity = body.linear_velocity;
+    body_slot.angular_velocity = body.angular_velocity;
+    body_slot.inverse_mass = body.inverse_mass;
+    body_slot.inverse_inertia_world = body.inverse_inertia_world;
+  }
+  return solver_.BodySide(solver_.BodySlotOf(body_slot), direction, point - body.position);
+}
+
+// Per point of a pair with a link: a normal row and two friction rows. The
+// normal row's target follows the rigid bodies' classification: a point
+// touching and closing faster than the collision threshold bounces with
+// restitution, v+ >= -e v-; one apart by s may close it within the step,
+// v+ >= -s / dt (so nothing passes through a link); one penetrating stops
+// sinking, v+ >= 0, and beyond the slop is pushed out by the split impulse
+// (CorrectLinkPenetration), which moves positions only. A point is
+// classified by v- at the start of the step, before the forces act (Baraff
+// 1997, "Rigid Body Simulation II", section 8): a link resting on the
+// ground closes at g dt by the end of the free step, above the collision
+// threshold, and with e > 0 it would hop every step.
+void ArticulationSystem::AddLinkContactRows(const StepContext& step,
+                                            const std::vector<int>& slot_of_articulation,
+                                            const std::vector<ArticulationKinematics>& kinematics) {
+  const LinkRowContext context{&slot_of_articulation, &kinematics};
+  link_pair_rows_.assign(link_pairs_.size(), -1);
+  link_penetrations_.clear();
+  for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
+    const ShapePairContact& pair = *link_pairs_[m];
+    for (int i = 0; i < pair.manifold.point_count; ++i) {
+      const int normal_index = AddLinkPointRows(step, context, pair, i);
+      if (i == 0) link_pair_rows_[m] = normal_index;
+    }
+  }
+}
+
+// Point `i` of a link pair: its normal row (classified as above) and two
+// friction rows; returns the normal row's index.
+int ArticulationSystem::AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+                                         const ShapePairContact& pair, int i) {
+  const SolverSettings& solver = step.settings->solver;
+  const Body& a = bodies_[pair.body_a];
+  const Body& b = bodies_[pair.body_b];
+  const Material& material_a = a.shapes[pair.shape_a].material;
+  const Material& material_b = b.shapes[pair.shape_b].material;
+  const double friction = CombineFriction(material_a.friction, material_b.friction);
+  const double restitution = CombineRestitution(material_a.restitution, material_b.restitution);
+  const Vec3 normal = pair.manifold.normal_world;
+  const std::array<Vec3, 2> tangent = TangentBasis(normal);
+  const ContactPoint& point = pair.manifold.points[i];
+  ConstraintRow normal_row;
+  normal_row.kind = RowKind::kNormal;
+  normal_row.restitution = restitution;
+  normal_row.a = LinkContactSide(context, pair.body_a, normal, point.position_world);
+  normal_row.b = LinkContactSide(context, pair.body_b, -normal, point.position_world);
+  const double approach =
+      StartPointVelocity(*context.kinematics, pair.body_a, normal, point.position_world) +
+      StartPointVelocity(*context.kinematics, pair.body_b, -normal, point.position_world);
+  const double separation = point.separation;
+  if (separation <= solver.contact_tolerance && approach < -solver.collision_velocity_threshold) {
+    normal_row.target = -restitution * approach;
+    normal_row.colliding = true;
+  } else if (separation > 0.0) {
+    normal_row.target = -separation / step.dt;
+    if (approach < -solver.collision_velocity_threshold && approach * step.dt < -separation) {
+      normal_row.bounce = -restitution * approach;
+    }
+  } else {
+    normal_row.target = 0.0;
+  }
+  const double depth = -separation - solver.penetration_slop;
+  normal_row.impulse = pair.warm_start[i].normal_impulse;
+  const int normal_index = solver_.AddRow(std::move(normal_row));
+  if (depth > 0.0) {
+    link_penetrations_.emplace_back(normal_index, solver.position_correction * depth / step.dt);
+  }
+  for (int t = 0; t < 2; ++t) {
+    ConstraintRow tangent_row;
+    tangent_row.kind = RowKind::kTangent;
+    tangent_row.a = LinkContactSide(context, pair.body_a, tangent[t], point.position_world);
+    tangent_row.b = LinkContactSide(context, pair.body_b, -tangent[t], point.position_world);
+    tangent_row.normal_row = normal_index;
+    tangent_row.friction = friction;
+    tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
+    solver_.AddRow(std::move(tangent_row));
+  }
+  return normal_index;
+}
+
+// Restitution of the link contacts that close within the step, at the
+// time they touch. A point still apart at the start of the step is stopped
+// where it touches by its row, v+ >= -s / dt. The velocity each
+// articulation had before those rows stopped it, u- = u - M^-1 J^T lambda
+// over their impulses (normal and friction), reaches the touch at
+// t_c = s / (-J u-), the earliest over its points: in joint coordinates the
+// step moves on the straight line q + t u, so the gap closes linearly. The
+// rows that took an impulse are then solved again, the others' impulses
+// held, for v+ >= -e v-, the speed it leaves with (Baraff 1997, "Rigid Body
+// Simulation II", section 8, the collision impulse at the time of contact),
+// and the articulation ends the step at q + t_c u- + (dt - t_c) u+, as a
+// rigid body does in the sub-step after its impact. A point whose other
+// side is a moving rigid body keeps the end of the step as its time: the
+// body's drift is the contact solver's (the restitution pass after the
+// position update of Box2D v3.0, Catto 2024, contact_solver.c).
+void ArticulationSystem::BounceLinkContacts(const StepContext& step,
+                                            const std::vector<int>& slot_of_articulation) {
+  std::vector<std::size_t>& bouncing = bouncing_rows_;
+  bouncing.clear();
+  solved_bodies_.clear();
+  std::vector<ConstraintRow>& rows = solver_.rows();
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (rows[k].bounce > 0.0 && rows[k].impulse > 0.0) bouncing.push_back(k);
+  }
+  if (bouncing.empty()) return;
+  const std::vector<double> impact_times = LinkImpactTimes(step, slot_of_articulation);
+  for (const std::size_t k : bouncing) {
+    rows[k].target = rows[k].bounce;
+    rows[k].colliding = true;
+  }
+  solved_bodies_ = solver_.bodies();
+  solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    const int slot = slot_of_articulation[i];
+    if (slot < 0) continue;
+    ArticulationEntry& entry = articulations_[i];
+    const Eigen::VectorXd& u_after = solver_.articulations()[slot].u;
+    const double t_c = impact_times[slot];
+    if (t_c < step.dt) {
+      const ArticulationState at_impact =
+          Advance(entry.model, entry.state, approach_velocities_[slot], t_c);
+      entry.next = Advance(entry.model, at_impact, u_after, step.dt - t_c);
+    }
+    entry.next.u = u_after;
+  }
+}
+
+// Per articulation slot, the time its first bouncing point touches (dt
+// when none is timed), and in approach_velocities_ its velocity before the
+// bouncing points' impulses; a timed point's bounce becomes -e times the
+// speed it strikes with. Reads the rows before their bounce targets.
+std::vector<double> ArticulationSystem::LinkImpactTimes(
+    const StepContext& step, const std::vector<int>& slot_of_articulation) {
+  std::vector<ConstraintRow>& rows = solver_.rows();
+  std::vector<ArticulationSolver::ArticulationSlot>& slots = solver_.articulations();
+  approach_velocities_.resize(slots.size());
+  for (std::size_t slot = 0; slot < slots.size(); ++slot)
+    approach_velocities_[slot] = slots[slot].u;
+  const auto remove_impulse = [&](const ConstraintRow& row) {
+    for (const RowSide* side : {&row.a, &row.b}) {
+      if (side->kind == RowSide::Kind::kArticulation) {
+        approach_velocities_[side->slot] -= row.impulse * side->response;
+      }
+    }
+  };
+  for (const std::size_t k : bouncing_rows_) {
+    remove_impulse(rows[k]);
+    for (std::size_t t = k + 1; t <= k + 2 && t < rows.size(); ++t) {
+      if (rows[t].kind == RowKind::kTangent && rows[t].normal_row == static_cast<int>(k)) {
+        remove_impulse(rows[t]);
+      }
+    }
+  }
+  std::vector<Eigen::VectorXd> start_velocities(slots.size());
+  for (std::size_t i = 0; i < articulations_.size(); ++i) {
+    const int slot = slot_of_articulation[i];
+    if (slot >= 0) start_velocities[slot] = articulations_[i].state.u;
+  }
+  std::vector<double> times(slots.size(), step.dt);
+  for (const std::size_t k : bouncing_rows_) {
+    const ConstraintRow& row = rows[k];
+    if (row.a.kind == RowSide::Kind::kBody || row.b.kind == RowSide::Kind::kBody) continue;
+    double closing = 0.0;  // J u-, m/s
+    for (const RowSide* side : {&row.a, &row.b}) {
+      if (side->kind == RowSide::Kind::kArticulation) {
+        closing += side->jacobian.dot(approach_velocities_[side->slot]);
+      }
+    }
+    const double gap = -row.target * step.dt;  // s of the target -s / dt
+    if (!(closing < 0.0) || !(gap >= 0.0)) continue;
+    const double time = std::min(gap / -closing, step.dt);
+    // It strikes with u_c = u(t_c) = u + (t_c / dt) (u- - u) (the forces
+    // act evenly over the step) and leaves with w, J w = -e J u_c; the
+    // forces then act over the rest of the step, u+ = w + (u- - u_c). So
+    // the row's target for u+ is -e J u_c + J (u- - u_c).
+    double closing_at_impact = 0.0;
+    for (const RowSide* side : {&row.a, &row.b}) {
+      if (side->kind != RowSide::Kind::kArticulation) continue;
+      times[side->slot] = std::min(times[side->slot], time);
+      const Eigen::VectorXd& start = start_velocities[side->slot];
+      closing_at_impact +=
+          side->jacobian.dot(start + (time / step.dt) * (approach_velocities_[side->slot] - start));
+    }
+    rows[k].bounce =
+        std::max(0.0, -row.restitution * closing_at_impact + (closing - closing_at_impact));
+  }
+  return times;
+}
+
+// The split impulse of the link contacts (the rigid bodies' is in
+// resting_contact.cc): pseudo velocities from rest, found by projected
+// Gauss-Seidel on the penetrating points' normal rows alone with
+// J u_p >= position_correction depth / dt, move the articulations' joint
+// positions and base by dt u_p and the rigid bodies by their pseudo
+// velocities, and change no real velocity. A link spawned into the ground
+// is lifted out without a launch speed; pushing through its real velocity
+// (Baumgarte) would give it position_correction depth / dt of real speed and, on a spinning
+// chain, feed it. The split impulse of Bullet's sequential-impulse solver
+// (btSequentialImpulseConstraintSolver), in joint coordinates; the
+// projected Gauss-Seidel is Erleben 2007, section 3.
+void ArticulationSystem::CorrectLinkPenetration(const StepContext& step,
+                                                const std::vector<int>& slot_of_articulation) {
+  if (link_penetrations_.empty()) return;
+  ArticulationSolver& pseudo = pseudo_solver_;
+  pseudo.Reset();
+  const std::vector<ArticulationSolver::ArticulationSlot>& velocity_slots = solver_.articulations();
+  const std::vector<ArticulationSolver::BodySlot>& velocity_bodies = solver_.bodies();
+  std::vector<int> pseudo_slot(velocity_slots.size(), -1);
+  auto remap = [&](RowSide side) {
+    if (side.kind == RowSide::Kind::kArticulation) {
+      int& slot = pseudo_slot[side.slot];
+      if (slot < 0) {
+        const ArticulationSolver::ArticulationSlot& from = velocity_slots[side.slot];
+        slot = pseudo.AddArticulation(Eigen::VectorXd::Zero(from.u.size()), from.mass);
+      }
+      side.slot = slot;
+    } else if (side.kind == RowSide::Kind::kBody) {
+      // A rigid body starts from the pseudo velocity its own solve gave it.
+      ArticulationSolver::BodySlot body = velocity_bodies[side.slot];
+      body.linear_velocity = bodies_[body.body].pseudo_linear_velocity;
+      body.angular_velocity = bodies_[body.body].pseudo_angular_velocity;
+      side.slot = pseudo.BodySlotOf(body);
+    }
+    return side;
+  };
+  for (const auto& [index, target] : link_penetrations_) {
+    const ConstraintRow& from = solver_.rows()[index];
+    ConstraintRow row;
+    row.kind = RowKind::kNormal;
+    row.a = remap(from.a);
+    row.b = remap(from.b);
+    row.target = target;
+    pseudo.AddRow(std::move(row));
+  }
+  // The joints' own rows (motors within their effort, servos, limits,
+  // friction, mimics) hold in the correction as in the velocity solve:
+  // pushing a box out of a link may turn a joint only as far as a push on
+  // it could, not freely past the motor that holds it.
+  for (const ConstraintRow& from : solver_.rows()) {
+    if (from.articulation < 0 || from.a.kind != RowSide::Kind::kArticulation ||
+        pseudo_slot[from.a.slot] < 0) {
+      continue;
+    }
+    ConstraintRow row = from;
+    row.a = remap(from.a);
+    row.b = remap(from.b);
+    row.target = 0.0;
+    row.impulse = 0.0;
+    row.colliding = false;
+    row.bounce = 0.0;
+    pseudo.AddRow(std::move(row));
+  }
+  pseudo.Solve(kMaxSweeps, kSweepTolerance);
+
+  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
+    const int slot = slot_of_articulation[i];
+    if (slot < 0 || pseudo_slot[slot] < 0) continue;
+    ArticulationEntry& entry = articulations_[i];
+    const Eigen::VectorXd velocity = entry.next.u;
+    entry.next =
+        Advance(entry.model, entry.next, pseudo.articulations()[pseudo_slot[slot]].u, step.dt);
+    entry.next.u = velocity;
+  }
+  for (const ArticulationSolver::BodySlot& slot_body : pseudo.bodies()) {
+    Body& body = bodies_[slot_body.body];
+    if (body.inverse_mass == 0.0 || !body.awake || body.disabled) continue;
+    body.pseudo_linear_velocity = slot_body.linear_velocity;
+    body.pseudo_angular_velocity = slot_body.angular_velocity;
+  }
+}
+
+// Keeps the link pairs' impulses for next step's warm start and reports
+// their points, as ReportContacts does for the rigid pairs.
+void ArticulationSystem::ReportContacts(const StepContext& step,
+                                        std::vector<ContactReport>* contacts,
+                                        std::vector<ContactReport>* collision_log) {
+  const std::vector<ConstraintRow>& rows = solver_.rows();
+  for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
+    ShapePairContact& pair = *link_pairs_[m];
+    const int first = link_pair_rows_[m];
+    pair.previous_count = first < 0 ? 0 : pair.manifold.point_count;
+    if (first < 0) continue;
+    const std::array<Vec3, 2> tangent = TangentBasis(pair.manifold.normal_world);
+    for (int i = 0; i < pair.manifold.point_count; ++i) {
+      const ConstraintRow& normal = rows[first + 3 * i];
+      const ContactPoint& point = pair.manifold.points[i];
+      pair.previous[i] =
+          CachedImpulse{point.feature,
+                        normal.impulse,
+                        {rows[first + 3 * i + 1].impulse, rows[first + 3 * i + 2].impulse},
+                        point.position_world};
+      const bool touching = point.separation <= step.settings->solver.contact_tolerance;
+      if (!touching && normal.impulse <= 0.0) continue;
+      ContactReport& report = contacts->emplace_back(world_.MakeReport(pair, i, tangent, step));
+      const bool colliding = normal.colliding && normal.impulse > 0.0;
+      report.type = colliding ? ContactType::kColliding : ContactType::kResting;
+      if (colliding) collision_log->push_back(report);
+    }
+  }
+}
+
+}  // namespace rigid_body_sim::physics
