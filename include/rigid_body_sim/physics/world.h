@@ -11,6 +11,7 @@
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/ray.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/types.h"
 #include "rigid_body_sim/physics/world_settings.h"
@@ -61,6 +62,15 @@ class World {
   // bodies by moving their positions only (the split impulse), so spawning
   // into an overlap gives no launch speed.
   std::vector<BodyOverlap> FindOverlaps(BodyId id) const;
+
+  // Casts each ray against the shapes of every enabled body but those in
+  // `ignore`: its first hit within its length (ray.h), through a tree of
+  // the shapes' boxes, on the world's threads for large batches. Refused
+  // whole, naming the ray, for a non-finite origin, a direction not of unit
+  // length, a max_distance below 0 or NaN, or more than kMaxRaysPerCast
+  // rays.
+  Result<std::vector<RayHit>> CastRays(const std::vector<Ray>& rays,
+                                       const std::vector<BodyId>& ignore = {}) const;
   double time() const;  // s since creation or the last Restart
   const StepProfile& last_step_profile() const;
 

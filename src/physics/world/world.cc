@@ -37,6 +37,10 @@ Status World::ApplyTorque(BodyId id, const Vec3& torque_world) {
 
 void World::Step() { impl_->Step(); }
 std::vector<BodyOverlap> World::FindOverlaps(BodyId id) const { return impl_->FindOverlaps(id); }
+Result<std::vector<RayHit>> World::CastRays(const std::vector<Ray>& rays,
+                                            const std::vector<BodyId>& ignore) const {
+  return impl_->CastRays(rays, ignore);
+}
 double World::time() const { return impl_->time(); }
 const StepProfile& World::last_step_profile() const { return impl_->last_step_profile(); }
 void World::Restart() { impl_->Restart(); }

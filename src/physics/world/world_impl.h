@@ -22,6 +22,7 @@
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/ray.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/types.h"
 #include "rigid_body_sim/physics/world_settings.h"
@@ -67,6 +68,9 @@ class WorldImpl : public LinkBodies {
   Status ApplyTorque(BodyId id, const Vec3& torque_world);
   void Step();
   std::vector<BodyOverlap> FindOverlaps(BodyId id) const;  // world_queries.cc
+  Result<std::vector<RayHit>> CastRays(
+      const std::vector<Ray>& rays,
+      const std::vector<BodyId>& ignore) const;  // world_ray_cast.cc
   double time() const { return time_; }
   const StepProfile& last_step_profile() const { return last_step_profile_; }
   void Restart();

@@ -1,0 +1,188 @@
+// World::CastRays: each ray against every enabled body's shapes, through a
+// bounding-volume tree of the shapes' world boxes built for the batch, on
+// the task pool for large batches.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_set>
+#include <variant>
+
+#include "physics/collision/ray_cast.h"
+#include "physics/geometry/aabb.h"
+#include "physics/geometry/shape_bounds.h"
+#include "physics/world/world_impl.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// Rays per task of the pool.
+constexpr std::size_t kRaysPerChunk = 256;
+constexpr double kUnitTolerance = 1e-9;
+
+// One shape of the scene, posed in the world.
+struct ShapeEntry {
+  std::uint32_t body = 0;
+  int shape = 0;
+  Pose world_from_shape;
+  Aabb box;
+};
+
+// A binary tree over the shapes' boxes, split at the median of the longest
+// axis of the centres (a top-down bounding-volume hierarchy, Goldsmith and
+// Salmon 1987; the median split of Kay and Kajiya 1986, section 4). A node
+// is a leaf of entries [first, first + count) or has children `left` and
+// `right`.
+struct ShapeTree {
+  struct Node {
+    Aabb box;
+    int left = -1;
+    int right = -1;
+    int first = 0;
+    int count = 0;
+  };
+  std::vector<ShapeEntry> entries;
+  std::vector<Node> nodes;
+
+  int Build(int first, int count) {
+    Node node;
+    node.box = entries[first].box;
+    for (int i = first + 1; i < first + count; ++i) {
+      node.box.min = node.box.min.cwiseMin(entries[i].box.min);
+      node.box.max = node.box.max.cwiseMax(entries[i].box.max);
+    }
+    const int index = static_cast<int>(nodes.size());
+    nodes.push_back(node);
+    if (count <= 2) {
+      nodes[index].first = first;
+      nodes[index].count = count;
+      return index;
+    }
+    int axis = 0;
+    (node.box.max - node.box.min).maxCoeff(&axis);
+    const auto begin = entries.begin() + first;
+    std::nth_element(begin, begin + count / 2, begin + count,
+                     [axis](const ShapeEntry& a, const ShapeEntry& b) {
+                       return a.box.min[axis] + a.box.max[axis] < b.box.min[axis] + b.box.max[axis];
+                     });
+    const int left = Build(first, count / 2);
+    const int right = Build(first + count / 2, count - count / 2);
+    nodes[index].left = left;
+    nodes[index].right = right;
+    return index;
+  }
+};
+
+Status ValidateRay(const Ray& ray, std::size_t index) {
+  const std::string name = "ray " + std::to_string(index) + ": ";
+  if (!IsFinite(ray.origin)) return Status::Error(name + "origin is not finite");
+  if (!IsFinite(ray.direction) || std::abs(ray.direction.norm() - 1.0) > kUnitTolerance) {
+    return Status::Error(name + "direction must be a finite unit vector, has length " +
+                         FormatNumber(ray.direction.norm()));
+  }
+  if (!(ray.max_distance >= 0.0)) {
+    return Status::Error(name + "max_distance " + FormatNumber(ray.max_distance) + " must be >= 0");
+  }
+  return Status::Ok();
+}
+
+void Consider(const ShapeEntry& entry, const ShapeGeometry& geometry, const Ray& ray,
+              const std::vector<Body>& bodies, RayHit* best) {
+  Ray shortened = ray;
+  shortened.max_distance = std::min(ray.max_distance, best->distance);
+  RayHit hit = RayCastShape(geometry, entry.world_from_shape, shortened);
+  if (!hit.hit || (best->hit && hit.distance >= best->distance)) return;
+  hit.body = BodyId{entry.body, bodies[entry.body].generation};
+  hit.shape = entry.shape;
+  *best = hit;
+}
+
+// The half-spaces, then the tree walked nearest child first, a node
+// skipped when its box begins beyond the nearest hit so far.
+RayHit CastOneRay(const Ray& ray, const ShapeTree& tree, const std::vector<ShapeEntry>& half_spaces,
+                  const std::vector<Body>& bodies) {
+  RayHit best;
+  const auto consider = [&](const ShapeEntry& entry) {
+    Consider(entry, bodies[entry.body].shapes[entry.shape].geometry, ray, bodies, &best);
+  };
+  for (const ShapeEntry& entry : half_spaces) consider(entry);
+  if (tree.nodes.empty()) return best;
+  const Vec3 inverse = SlabInverse(ray.direction);
+  const auto reach = [&]() { return best.hit ? best.distance : ray.max_distance; };
+  const auto slabs = [&](const ShapeTree::Node& node) {
+    return RaySlabs(ray.origin, inverse, node.box.min, node.box.max, reach());
+  };
+  // Depth-first, at most one pending sibling per level: the median split
+  // keeps the depth under log2(shapes) + 2.
+  struct Pending {
+    int node;
+    double entry;
+  };
+  std::array<Pending, 64> stack;
+  int size = 0;
+  const SlabInterval root = slabs(tree.nodes[0]);
+  if (root.entry <= root.exit) stack[size++] = {0, root.entry};
+  while (size > 0) {
+    const Pending pending = stack[--size];
+    if (pending.entry > reach()) continue;
+    const ShapeTree::Node& node = tree.nodes[pending.node];
+    if (node.left < 0) {
+      for (int i = node.first; i < node.first + node.count; ++i) consider(tree.entries[i]);
+      continue;
+    }
+    const SlabInterval left = slabs(tree.nodes[node.left]);
+    const SlabInterval right = slabs(tree.nodes[node.right]);
+    const bool left_first = left.entry <= right.entry;
+    const SlabInterval& near = left_first ? left : right;
+    const SlabInterval& far = left_first ? right : left;
+    if (far.entry <= far.exit) stack[size++] = {left_first ? node.right : node.left, far.entry};
+    if (near.entry <= near.exit) stack[size++] = {left_first ? node.left : node.right, near.entry};
+  }
+  return best;
+}
+
+}  // namespace
+
+Result<std::vector<RayHit>> WorldImpl::CastRays(const std::vector<Ray>& rays,
+                                                const std::vector<BodyId>& ignore) const {
+  if (rays.size() > kMaxRaysPerCast) {
+    return Status::Error("rays: " + std::to_string(rays.size()) + " rays, at most " +
+                         std::to_string(kMaxRaysPerCast));
+  }
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (Status status = ValidateRay(rays[i], i); !status.ok()) return status;
+  }
+  std::unordered_set<std::uint32_t> ignored;
+  for (const BodyId id : ignore) {
+    if (IsValid(id)) ignored.insert(id.index);
+  }
+  ShapeTree tree;
+  std::vector<ShapeEntry> half_spaces;
+  for (std::uint32_t b = 0; b < bodies_.size(); ++b) {
+    const Body& body = bodies_[b];
+    if (!body.in_use || body.disabled || ignored.count(b) > 0) continue;
+    const Pose world_from_body = body.WorldFromBody();
+    for (std::size_t s = 0; s < body.shapes.size(); ++s) {
+      const ShapeGeometry& geometry = body.shapes[s].geometry;
+      // A static mesh's extra contact slots are copies of its first.
+      if (const auto* mesh = std::get_if<StaticMesh>(&geometry); mesh && mesh->slot != 0) continue;
+      ShapeEntry entry{b, static_cast<int>(s), world_from_body * body.shapes[s].body_from_shape,
+                       Aabb{}};
+      if (std::holds_alternative<HalfSpace>(geometry)) {
+        half_spaces.push_back(entry);
+        continue;
+      }
+      entry.box = ShapeAabb(geometry, entry.world_from_shape);
+      tree.entries.push_back(entry);
+    }
+  }
+  if (!tree.entries.empty()) tree.Build(0, static_cast<int>(tree.entries.size()));
+  std::vector<RayHit> hits(rays.size());
+  pool_->ParallelFor(rays.size(), kRaysPerChunk, [&](std::size_t i) {
+    hits[i] = CastOneRay(rays[i], tree, half_spaces, bodies_);
+  });
+  return hits;
+}
+
+}  // namespace rigid_body_sim::physics
