@@ -100,6 +100,40 @@ Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
   return FrameState{*world_from_frame, *linear, *angular};
 }
 
+Result<std::vector<physics::Ray>> RaysFromMsg(const std::vector<geometry_msgs::Point>& origins,
+                                              const std::vector<geometry_msgs::Vector3>& directions,
+                                              double max_distance) {
+  using Rays = Result<std::vector<physics::Ray>>;
+  if (origins.size() != directions.size()) {
+    return Rays::Error("origins has " + std::to_string(origins.size()) + " entries, directions " +
+                       std::to_string(directions.size()) + "; they must match");
+  }
+  if (origins.size() > physics::kMaxRaysPerCast) {
+    return Rays::Error("origins has " + std::to_string(origins.size()) +
+                       " rays, more than the limit " + std::to_string(physics::kMaxRaysPerCast));
+  }
+  if (!(max_distance > 0.0)) {
+    return Rays::Error("max_distance " + physics::FormatNumber(max_distance) +
+                       " m must be > 0 (inf for no limit)");
+  }
+  std::vector<physics::Ray> rays(origins.size());
+  for (std::size_t i = 0; i < origins.size(); ++i) {
+    const std::string index = "[" + std::to_string(i) + "]";
+    Result<Vec3> origin = PointFromMsg(origins[i], "origins" + index);
+    if (!origin.ok()) return origin.status();
+    Result<Vec3> direction = VectorFromMsg(directions[i], "directions" + index);
+    if (!direction.ok()) return direction.status();
+    // A direction whose norm underflows or overflows cannot be normalised.
+    const double length = direction->norm();
+    if (!(length > 0.0) || !std::isfinite(length)) {
+      return Rays::Error("directions" + index + " " + Describe(*direction) +
+                         " has no direction (length " + physics::FormatNumber(length) + ")");
+    }
+    rays[i] = physics::Ray{*origin, *direction / length, max_distance};
+  }
+  return rays;
+}
+
 Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request) {
   Result<FrameState> state = FrameStateFromMsg(request.pose, request.twist);
   if (!state.ok()) return state.status();

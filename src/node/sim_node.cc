@@ -213,6 +213,7 @@ void SimNode::AdvertiseServices() {
   services_.push_back(Advertise(names::kStepService, &Self::OnStep));
   services_.push_back(Advertise(names::kCancelStepService, &Self::OnCancelStep));
   services_.push_back(Advertise(names::kGetStateService, &Self::OnGetState));
+  services_.push_back(Advertise(names::kRayCastService, &Self::OnRayCast));
   services_.push_back(Advertise(names::kSetStateService, &Self::OnSetState));
   services_.push_back(Advertise(names::kSetJointStateService, &Self::OnSetJointState));
   services_.push_back(Advertise(names::kApplyWrenchService, &Self::OnApplyWrench));

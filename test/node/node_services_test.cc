@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -344,6 +345,89 @@ TEST_F(NodeServicesTest, UrdfCylinderRollsDownARampAtTwoThirdsGSinTheta) {
   const double expected = 9.81 * std::sin(theta) / 3.0;
   EXPECT_NEAR(along / expected, 1.0, 1e-4);
   EXPECT_NEAR(moved[0] * normal[0] + moved[2] * normal[2], 0.0, 1e-6);
+}
+
+geometry_msgs::Point MakePoint(double x, double y, double z) {
+  geometry_msgs::Point point;
+  point.x = x;
+  point.y = y;
+  point.z = z;
+  return point;
+}
+
+geometry_msgs::Vector3 MakeVector(double x, double y, double z) {
+  geometry_msgs::Vector3 vector;
+  vector.x = x;
+  vector.y = y;
+  vector.z = z;
+  return vector;
+}
+
+// A 1 m cube at (3, 0, 40) and the ground: a ray along x at the cube's
+// height enters its face x = 2.5 (the direction's length does not matter),
+// one straight down from z = 10 meets the ground at 10 m, one up meets
+// nothing; in the cube's own frame the same face is at x = -0.5.
+TEST_F(NodeServicesTest, RayCastHitsTheBoxAndTheGroundInTheRequestedFrame) {
+  SpawnBox("ray_box", MakePose(3.0, 0.0, 40.0));
+  rigid_body_sim::RayCast::Request request;
+  request.origins = {MakePoint(0, 0, 40), MakePoint(0, 0.2, 10), MakePoint(0, 0, 10)};
+  request.directions = {MakeVector(2, 0, 0), MakeVector(0, 0, -1), MakeVector(0, 0, 1)};
+  request.max_distance = std::numeric_limits<double>::infinity();
+  auto reply = client_.RayCast(request);
+  ASSERT_TRUE(reply.success) << reply.message;
+  ASSERT_EQ(reply.hit.size(), 3u);
+  EXPECT_TRUE(reply.hit[0]);
+  EXPECT_NEAR(reply.distance[0], 2.5, 1e-12);
+  EXPECT_NEAR(reply.points[0].x, 2.5, 1e-12);
+  EXPECT_NEAR(reply.normals[0].x, -1.0, 1e-12);
+  EXPECT_EQ(reply.hit_frames[0], "ray_box/base_link");
+  EXPECT_TRUE(reply.hit[1]);
+  EXPECT_NEAR(reply.distance[1], 10.0, 1e-12);
+  EXPECT_NEAR(reply.normals[1].z, 1.0, 1e-12);
+  EXPECT_EQ(reply.hit_frames[1], "ground");
+  EXPECT_FALSE(reply.hit[2]);
+  EXPECT_TRUE(std::isinf(reply.distance[2]));
+  EXPECT_EQ(reply.hit_frames[2], "");
+
+  request.frame_id = "ray_box";
+  request.origins = {MakePoint(-3, 0, 0)};
+  request.directions = {MakeVector(1, 0, 0)};
+  reply = client_.RayCast(request);
+  ASSERT_TRUE(reply.success) << reply.message;
+  EXPECT_NEAR(reply.distance[0], 2.5, 1e-12);
+  EXPECT_NEAR(reply.points[0].x, -0.5, 1e-12);
+  EXPECT_NEAR(reply.points[0].z, 0.0, 1e-12);
+
+  request.ignore_models = {"ray_box"};
+  reply = client_.RayCast(request);
+  ASSERT_TRUE(reply.success) << reply.message;
+  EXPECT_FALSE(reply.hit[0]);
+
+  // Refused whole, naming the field.
+  const auto refused = [&](rigid_body_sim::RayCast::Request bad, const std::string& field) {
+    const auto answer = client_.RayCast(bad);
+    EXPECT_FALSE(answer.success);
+    EXPECT_NE(answer.message.find(field), std::string::npos) << answer.message;
+    EXPECT_TRUE(answer.hit.empty());
+  };
+  rigid_body_sim::RayCast::Request bad = request;
+  bad.ignore_models = {"no_such_model"};
+  refused(bad, "ignore_models[0]");
+  bad = request;
+  bad.frame_id = "no_such_model/link";
+  refused(bad, "frame_id");
+  bad = request;
+  bad.directions = {MakeVector(0, 0, 0)};
+  refused(bad, "directions[0]");
+  bad = request;
+  bad.origins[0].y = std::nan("");
+  refused(bad, "origins[0]");
+  bad = request;
+  bad.max_distance = 0.0;
+  refused(bad, "max_distance");
+  bad = request;
+  bad.directions.push_back(MakeVector(1, 0, 0));
+  refused(bad, "directions");
 }
 
 TEST_F(NodeServicesTest, BadInputIsRefusedAndChangesNothing) {

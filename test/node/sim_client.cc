@@ -125,6 +125,11 @@ rigid_body_sim::GetState::Response SimClient::GetState(const std::string& name) 
   return Call<rigid_body_sim::GetState>("get_state", request);
 }
 
+rigid_body_sim::RayCast::Response SimClient::RayCast(
+    const rigid_body_sim::RayCast::Request& request) {
+  return Call<rigid_body_sim::RayCast>("ray_cast", request);
+}
+
 rigid_body_sim::SetState::Response SimClient::SetState(
     const rigid_body_sim::SetState::Request& request) {
   return Call<rigid_body_sim::SetState>("set_state", request);

@@ -20,6 +20,7 @@
 #include "rigid_body_sim/GetPhysics.h"
 #include "rigid_body_sim/GetState.h"
 #include "rigid_body_sim/ModelStates.h"
+#include "rigid_body_sim/RayCast.h"
 #include "rigid_body_sim/SetPhysics.h"
 #include "rigid_body_sim/SetState.h"
 #include "rigid_body_sim/Spawn.h"
@@ -55,6 +56,7 @@ class SimClient {
                                             const geometry_msgs::Pose& pose);
   rigid_body_sim::Delete::Response Delete(const std::string& name);
   rigid_body_sim::GetState::Response GetState(const std::string& name);
+  rigid_body_sim::RayCast::Response RayCast(const rigid_body_sim::RayCast::Request& request);
   rigid_body_sim::SetState::Response SetState(const rigid_body_sim::SetState::Request& request);
   rigid_body_sim::ApplyWrench::Response ApplyWrench(
       const rigid_body_sim::ApplyWrench::Request& request);

@@ -26,6 +26,7 @@
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
 #include "rigid_body_sim/physics/contact.h"
+#include "rigid_body_sim/physics/ray.h"
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/shape.h"
 #include "rigid_body_sim/physics/types.h"
@@ -48,6 +49,14 @@ physics::Result<FrameState> FrameStateFromMsg(const geometry_msgs::Pose& pose,
                                               const geometry_msgs::Twist& twist);
 // The spawn request as a spec; checks the pose, the twist and that the joint
 // fields pair up without repeats (the loader checks names and limits).
+// The rays of a ~ray_cast request in its own frame: one per origin and
+// direction (normalised), each up to max_distance. Fails naming the field
+// for a count mismatch, more than physics::kMaxRaysPerCast rays, a
+// non-finite origin, a zero or non-finite direction, or a max_distance
+// that is not > 0.
+physics::Result<std::vector<physics::Ray>> RaysFromMsg(
+    const std::vector<geometry_msgs::Point>& origins,
+    const std::vector<geometry_msgs::Vector3>& directions, double max_distance);
 physics::Result<ModelSpec> ModelSpecFromMsg(const rigid_body_sim::Spawn::Request& request);
 
 // The joint topics' messages as the plain requests joint_requests.h checks;

@@ -14,6 +14,7 @@ inline constexpr char kResetService[] = "reset";
 inline constexpr char kSetPausedService[] = "set_paused";
 inline constexpr char kStepService[] = "step";
 inline constexpr char kGetStateService[] = "get_state";
+inline constexpr char kRayCastService[] = "ray_cast";
 inline constexpr char kSetStateService[] = "set_state";
 inline constexpr char kApplyWrenchService[] = "apply_wrench";
 inline constexpr char kGetPhysicsService[] = "get_physics";

@@ -37,6 +37,7 @@
 #include "rigid_body_sim/GetWorldProperties.h"
 #include "rigid_body_sim/ModelStates.h"
 #include "rigid_body_sim/PhysicsConfig.h"
+#include "rigid_body_sim/RayCast.h"
 #include "rigid_body_sim/SetJointState.h"
 #include "rigid_body_sim/SetPhysics.h"
 #include "rigid_body_sim/SetState.h"
@@ -182,6 +183,9 @@ class SimNode {
   bool OnStep(rigid_body_sim::Step::Request& request, rigid_body_sim::Step::Response& response);
   bool OnGetState(rigid_body_sim::GetState::Request& request,
                   rigid_body_sim::GetState::Response& response);
+  // sim_ray_cast.cc
+  bool OnRayCast(rigid_body_sim::RayCast::Request& request,
+                 rigid_body_sim::RayCast::Response& response);
   bool OnSetState(rigid_body_sim::SetState::Request& request,
                   rigid_body_sim::SetState::Response& response);
   bool OnApplyWrench(rigid_body_sim::ApplyWrench::Request& request,

@@ -1,0 +1,88 @@
+// ~ray_cast: rays in a frame of the request, cast against the world's
+// shapes (physics::World::CastRays), answered in the same frame.
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <ros/console.h>
+
+#include "rigid_body_sim/node/msg_conversion.h"
+#include "rigid_body_sim/node/names.h"
+#include "rigid_body_sim/node/sim_node.h"
+
+namespace rigid_body_sim::node {
+
+using physics::Pose;
+using physics::Result;
+using physics::Status;
+
+namespace {
+
+bool Refuse(rigid_body_sim::RayCast::Response& response, const std::string& message) {
+  response.success = false;
+  response.message = message;
+  ROS_WARN("~%s refused: %s", names::kRayCastService, message.c_str());
+  return true;
+}
+
+}  // namespace
+
+bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
+                        rigid_body_sim::RayCast::Response& response) {
+  // Parsed and checked whole before the world is locked.
+  Result<std::vector<physics::Ray>> rays =
+      RaysFromMsg(request.origins, request.directions, request.max_distance);
+  if (!rays.ok()) return Refuse(response, rays.message());
+  std::vector<physics::RayHit> hits;
+  Pose world_from_frame = Pose::Identity();
+  {
+    std::unique_lock<std::mutex> lock = LockWorld();
+    if (!request.frame_id.empty()) {
+      Result<FrameRef> frame = registry_.ResolveFrame(request.frame_id);
+      if (!frame.ok()) return Refuse(response, "frame_id: " + frame.message());
+      world_from_frame =
+          LinkStateLocked(*frame->model,
+                          static_cast<std::size_t>(frame->link - frame->model->links.data()))
+              .world_from_frame;
+    }
+    std::vector<physics::BodyId> ignore;
+    for (std::size_t i = 0; i < request.ignore_models.size(); ++i) {
+      const Model* model = registry_.Find(request.ignore_models[i]);
+      if (model == nullptr) {
+        return Refuse(response, "ignore_models[" + std::to_string(i) + "]: no model named '" +
+                                    request.ignore_models[i] + "'");
+      }
+      ignore.insert(ignore.end(), model->bodies.begin(), model->bodies.end());
+    }
+    for (physics::Ray& ray : *rays) {
+      ray.origin = world_from_frame * ray.origin;
+      ray.direction = world_from_frame.rotation * ray.direction;
+    }
+    Result<std::vector<physics::RayHit>> cast = world_.CastRays(*rays, ignore);
+    if (!cast.ok()) return Refuse(response, cast.message());
+    hits = std::move(cast).value();
+    response.hit_frames.resize(hits.size());
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+      if (!hits[i].hit) continue;
+      response.hit_frames[i] = ground_ && hits[i].body == *ground_
+                                   ? std::string(names::kGroundName)
+                                   : registry_.ShapeFrame(hits[i].body, hits[i].shape);
+    }
+  }
+  const Pose frame_from_world = world_from_frame.Inverse();
+  response.hit.resize(hits.size());
+  response.distance.resize(hits.size());
+  response.points.resize(hits.size());
+  response.normals.resize(hits.size());
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    response.hit[i] = hits[i].hit;
+    response.distance[i] = hits[i].distance;
+    if (!hits[i].hit) continue;
+    response.points[i] = PointToMsg(frame_from_world * hits[i].point);
+    response.normals[i] = VectorToMsg(frame_from_world.rotation * hits[i].normal);
+  }
+  response.success = true;
+  return true;
+}
+
+}  // namespace rigid_body_sim::node
