@@ -2,6 +2,7 @@
 // shapes (physics::World::CastRays), answered in the same frame.
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ros/console.h>
@@ -33,6 +34,7 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
   Result<std::vector<physics::Ray>> rays =
       RaysFromMsg(request.origins, request.directions, request.max_distance);
   if (!rays.ok()) return Refuse(response, rays.message());
+  std::vector<physics::Ray> world_rays = std::move(rays).value();
   std::vector<physics::RayHit> hits;
   Pose world_from_frame = Pose::Identity();
   {
@@ -54,11 +56,11 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
       }
       ignore.insert(ignore.end(), model->bodies.begin(), model->bodies.end());
     }
-    for (physics::Ray& ray : *rays) {
+    for (physics::Ray& ray : world_rays) {
       ray.origin = world_from_frame * ray.origin;
       ray.direction = world_from_frame.rotation * ray.direction;
     }
-    Result<std::vector<physics::RayHit>> cast = world_.CastRays(*rays, ignore);
+    Result<std::vector<physics::RayHit>> cast = world_.CastRays(world_rays, ignore);
     if (!cast.ok()) return Refuse(response, cast.message());
     hits = std::move(cast).value();
     response.hit_frames.resize(hits.size());

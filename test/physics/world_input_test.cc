@@ -39,6 +39,20 @@ class WorldInputTest : public ::testing::Test {
   BodyId existing_;
 };
 
+// The motion solver is chosen by a setting; a kind that is none is refused
+// and the world keeps its settings.
+TEST_F(WorldInputTest, RefusesAMotionSolverThatIsNone) {
+  WorldSettings settings;
+  EXPECT_TRUE(ValidateWorldSettings(settings).ok());
+  settings.motion_solver = static_cast<MotionSolverKind>(7);
+  const Status status = ValidateWorldSettings(settings);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("motion_solver 7"), std::string::npos) << status.message();
+  World world;
+  EXPECT_FALSE(world.SetSettings(settings).ok());
+  EXPECT_EQ(world.settings().motion_solver, MotionSolverKind::kExact);
+}
+
 TEST_F(WorldInputTest, RefusesNonFinitePose) {
   BodyDef def = UnitBox();
   def.world_from_body.translation.x() = kNaN;

@@ -4,6 +4,7 @@
 #define RIGID_BODY_SIM_PHYSICS_WORLD_SETTINGS_H_
 
 #include <cstddef>
+#include <cstdint>
 
 #include "rigid_body_sim/physics/result.h"
 #include "rigid_body_sim/physics/types.h"
@@ -79,6 +80,8 @@ struct SleepSettings {
 // The most threads WorldSettings::threads may ask for.
 constexpr int kMaxThreads = 256;
 
+enum class MotionSolverKind : std::uint8_t { kExact };
+
 struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
   double time_step = 1.0 / 240.0;        // s, > 0
@@ -106,7 +109,11 @@ struct WorldSettings {
   // one thread, so the result is the same bit for bit for any count. 1 (the
   // default) starts no thread and is the reference path.
   int threads = 1;
-  SolverSettings solver;
+  // The solver of the stages from velocities to positions (the contact
+  // solve and the impacts): kExact, Baraff's classification and the exact
+  // time of impact (docs/design.md, stages 4 and 5), the only one so far.
+  MotionSolverKind motion_solver = MotionSolverKind::kExact;
+  SolverSettings solver;  // kExact's
   SleepSettings sleep;
 };
 

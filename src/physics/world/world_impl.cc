@@ -34,7 +34,9 @@ std::unique_ptr<TaskPool> MakePool(const WorldSettings& settings) {
 }  // namespace
 
 WorldImpl::WorldImpl(const WorldSettings& settings)
-    : settings_(settings), pool_(MakePool(settings)) {
+    : settings_(settings),
+      pool_(MakePool(settings)),
+      motion_solver_(MakeMotionSolver(settings.motion_solver, this)) {
   assert(ValidateWorldSettings(settings).ok());
   solver_.set_pool(pool_.get());
 }
@@ -45,6 +47,9 @@ Status WorldImpl::SetSettings(const WorldSettings& settings) {
   if (ResolveThreadCount(settings.threads) != pool_->threads()) {
     pool_ = MakePool(settings);
     solver_.set_pool(pool_.get());
+  }
+  if (settings.motion_solver != settings_.motion_solver) {
+    motion_solver_ = MakeMotionSolver(settings.motion_solver, this);
   }
   settings_ = settings;
   return status;
@@ -318,9 +323,9 @@ void WorldImpl::Step() {
   profile.narrow_phase_ms = lap();
   UpdateContactCache();
   profile.contact_cache_ms = lap();
-  SolveContacts(step);
+  motion_solver_->Solve(step);
   profile.solver_ms = lap();
-  IntegrateBodies(step);
+  motion_solver_->Integrate(step);
   profile.integrator_ms = lap();
   GuardAfterStep();
 

@@ -17,6 +17,7 @@
 #include "physics/dynamics/integrator.h"
 #include "physics/dynamics/sleep_window.h"
 #include "physics/solver/contact_solver.h"
+#include "physics/solver/motion_solver.h"
 #include "physics/world/step_context.h"
 #include "physics/world/task_pool.h"
 #include "rigid_body_sim/physics/articulation.h"
@@ -102,6 +103,8 @@ class WorldImpl : public LinkBodies {
   }
 
  private:
+  friend class ExactSolver;  // runs stages 4 and 5 below
+
   Body& MutableBody(BodyId id);
   // LinkBodies, for the articulation system.
   BodyId BodyIdOf(std::uint32_t index) const override;
@@ -170,8 +173,9 @@ class WorldImpl : public LinkBodies {
                            const StepContext& step) const override;
 
   WorldSettings settings_;
-  std::unique_ptr<TaskPool> pool_;      // settings_.threads threads
-  std::vector<NarrowJob> narrow_jobs_;  // stage 2's, in the order the pairs were visited
+  std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
+  std::unique_ptr<MotionSolver> motion_solver_;  // settings_.motion_solver
+  std::vector<NarrowJob> narrow_jobs_;           // stage 2's, in the order the pairs were visited
   // FindImpacts' per pair: the time of impact (s, +infinity for none) and
   // the speed the surfaces meet at (m/s).
   struct ImpactSearch {

@@ -86,6 +86,11 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
                               std::to_string(kMaxThreads) + "] (0: one per core)"),
           FiniteAbove("sleep.speeding_up_time", sleep.speeding_up_time, 0.0, false,
                       "finite and >= 0 (s)"),
+          settings.motion_solver == MotionSolverKind::kExact
+              ? Status::Ok()
+              : Status::Error("motion_solver " +
+                              std::to_string(static_cast<int>(settings.motion_solver)) +
+                              " is not a solver; kExact (0) is the one there is"),
       });
       !status.ok()) {
     return status;
