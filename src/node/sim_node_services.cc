@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "node/service_reply.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 #include "rigid_body_sim/node/request_validation.h"
@@ -18,18 +19,6 @@ using physics::FormatNumber;
 using physics::Result;
 using physics::Status;
 using physics::Vec3;
-
-namespace {
-
-template <typename Response>
-bool Fail(Response& response, const std::string& message, const char* service) {
-  response.success = false;
-  response.message = message;
-  ROS_WARN("~%s refused: %s", service, message.c_str());
-  return true;
-}
-
-}  // namespace
 
 bool SimNode::OnSpawn(rigid_body_sim::Spawn::Request& request,
                       rigid_body_sim::Spawn::Response& response) {

@@ -5,8 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include <ros/console.h>
-
+#include "node/service_reply.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 #include "rigid_body_sim/node/sim_node.h"
@@ -17,23 +16,12 @@ using physics::Pose;
 using physics::Result;
 using physics::Status;
 
-namespace {
-
-bool Refuse(rigid_body_sim::RayCast::Response& response, const std::string& message) {
-  response.success = false;
-  response.message = message;
-  ROS_WARN("~%s refused: %s", names::kRayCastService, message.c_str());
-  return true;
-}
-
-}  // namespace
-
 bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
                         rigid_body_sim::RayCast::Response& response) {
   // Parsed and checked whole before the world is locked.
   Result<std::vector<physics::Ray>> rays =
       RaysFromMsg(request.origins, request.directions, request.max_distance);
-  if (!rays.ok()) return Refuse(response, rays.message());
+  if (!rays.ok()) return Fail(response, rays.message(), names::kRayCastService);
   std::vector<physics::Ray> world_rays = std::move(rays).value();
   std::vector<physics::RayHit> hits;
   Pose world_from_frame = Pose::Identity();
@@ -41,7 +29,8 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
     std::unique_lock<std::mutex> lock = LockWorld();
     if (!request.frame_id.empty()) {
       Result<FrameRef> frame = registry_.ResolveFrame(request.frame_id);
-      if (!frame.ok()) return Refuse(response, "frame_id: " + frame.message());
+      if (!frame.ok())
+        return Fail(response, "frame_id: " + frame.message(), names::kRayCastService);
       world_from_frame =
           LinkStateLocked(*frame->model,
                           static_cast<std::size_t>(frame->link - frame->model->links.data()))
@@ -51,8 +40,10 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
     for (std::size_t i = 0; i < request.ignore_models.size(); ++i) {
       const Model* model = registry_.Find(request.ignore_models[i]);
       if (model == nullptr) {
-        return Refuse(response, "ignore_models[" + std::to_string(i) + "]: no model named '" +
-                                    request.ignore_models[i] + "'");
+        return Fail(response,
+                    "ignore_models[" + std::to_string(i) + "]: no model named '" +
+                        request.ignore_models[i] + "'",
+                    names::kRayCastService);
       }
       ignore.insert(ignore.end(), model->bodies.begin(), model->bodies.end());
     }
@@ -61,7 +52,7 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
       ray.direction = world_from_frame.rotation * ray.direction;
     }
     Result<std::vector<physics::RayHit>> cast = world_.CastRays(world_rays, ignore);
-    if (!cast.ok()) return Refuse(response, cast.message());
+    if (!cast.ok()) return Fail(response, cast.message(), names::kRayCastService);
     hits = std::move(cast).value();
     response.hit_frames.resize(hits.size());
     for (std::size_t i = 0; i < hits.size(); ++i) {

@@ -3,6 +3,7 @@
 #include <cassert>
 #include <string>
 
+#include "node/service_reply.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 #include "rigid_body_sim/node/sim_node.h"
@@ -84,10 +85,8 @@ bool SimNode::OnGetModelProperties(rigid_body_sim::GetModelProperties::Request& 
   std::unique_lock<std::mutex> lock = LockWorld();
   const Model* model = registry_.Find(request.name);
   if (model == nullptr) {
-    response.success = false;
-    response.message = "no model named '" + request.name + "'";
-    ROS_WARN("~%s refused: %s", names::kGetModelPropertiesService, response.message.c_str());
-    return true;
+    return Fail(response, "no model named '" + request.name + "'",
+                names::kGetModelPropertiesService);
   }
   ModelPropertiesToMsg(*model, &response);
   response.success = true;

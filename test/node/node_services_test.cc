@@ -12,6 +12,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "rigid_body_sim/node/msg_conversion.h"
 #include "sim_client.h"
 
 namespace rigid_body_sim::test {
@@ -347,31 +348,18 @@ TEST_F(NodeServicesTest, UrdfCylinderRollsDownARampAtTwoThirdsGSinTheta) {
   EXPECT_NEAR(moved[0] * normal[0] + moved[2] * normal[2], 0.0, 1e-6);
 }
 
-geometry_msgs::Point MakePoint(double x, double y, double z) {
-  geometry_msgs::Point point;
-  point.x = x;
-  point.y = y;
-  point.z = z;
-  return point;
-}
-
-geometry_msgs::Vector3 MakeVector(double x, double y, double z) {
-  geometry_msgs::Vector3 vector;
-  vector.x = x;
-  vector.y = y;
-  vector.z = z;
-  return vector;
-}
-
 // A 1 m cube at (3, 0, 40) and the ground: a ray along x at the cube's
 // height enters its face x = 2.5 (the direction's length does not matter),
 // one straight down from z = 10 meets the ground at 10 m, one up meets
 // nothing; in the cube's own frame the same face is at x = -0.5.
 TEST_F(NodeServicesTest, RayCastHitsTheBoxAndTheGroundInTheRequestedFrame) {
+  using physics::Vec3;
   SpawnBox("ray_box", MakePose(3.0, 0.0, 40.0));
   rigid_body_sim::RayCast::Request request;
-  request.origins = {MakePoint(0, 0, 40), MakePoint(0, 0.2, 10), MakePoint(0, 0, 10)};
-  request.directions = {MakeVector(2, 0, 0), MakeVector(0, 0, -1), MakeVector(0, 0, 1)};
+  request.origins = {node::PointToMsg(Vec3(0, 0, 40)), node::PointToMsg(Vec3(0, 0.2, 10)),
+                     node::PointToMsg(Vec3(0, 0, 10))};
+  request.directions = {node::VectorToMsg(Vec3(2, 0, 0)), node::VectorToMsg(Vec3(0, 0, -1)),
+                        node::VectorToMsg(Vec3(0, 0, 1))};
   request.max_distance = std::numeric_limits<double>::infinity();
   auto reply = client_.RayCast(request);
   ASSERT_TRUE(reply.success) << reply.message;
@@ -390,8 +378,8 @@ TEST_F(NodeServicesTest, RayCastHitsTheBoxAndTheGroundInTheRequestedFrame) {
   EXPECT_EQ(reply.hit_frames[2], "");
 
   request.frame_id = "ray_box";
-  request.origins = {MakePoint(-3, 0, 0)};
-  request.directions = {MakeVector(1, 0, 0)};
+  request.origins = {node::PointToMsg(Vec3(-3, 0, 0))};
+  request.directions = {node::VectorToMsg(Vec3(1, 0, 0))};
   reply = client_.RayCast(request);
   ASSERT_TRUE(reply.success) << reply.message;
   EXPECT_NEAR(reply.distance[0], 2.5, 1e-12);
@@ -417,7 +405,7 @@ TEST_F(NodeServicesTest, RayCastHitsTheBoxAndTheGroundInTheRequestedFrame) {
   bad.frame_id = "no_such_model/link";
   refused(bad, "frame_id");
   bad = request;
-  bad.directions = {MakeVector(0, 0, 0)};
+  bad.directions = {node::VectorToMsg(Vec3(0, 0, 0))};
   refused(bad, "directions[0]");
   bad = request;
   bad.origins[0].y = std::nan("");
@@ -426,7 +414,7 @@ TEST_F(NodeServicesTest, RayCastHitsTheBoxAndTheGroundInTheRequestedFrame) {
   bad.max_distance = 0.0;
   refused(bad, "max_distance");
   bad = request;
-  bad.directions.push_back(MakeVector(1, 0, 0));
+  bad.directions.push_back(node::VectorToMsg(Vec3(1, 0, 0)));
   refused(bad, "directions");
 }
 

@@ -119,7 +119,7 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
   // reads the bodies' poses, which no stage-2 work changes, and writes its
   // own cache entry only, so the manifolds are the same whichever thread
   // tests which pair, and the order of the entries is the walk's.
-  pool_->ParallelFor(narrow_jobs_.size(), kJobsPerChunk, [this](std::size_t j) {
+  step.pool->ParallelFor(narrow_jobs_.size(), kJobsPerChunk, [this](std::size_t j) {
     if (j + kEntryPrefetchDistance < narrow_jobs_.size()) {
       PrefetchManifold(*narrow_jobs_[j + kEntryPrefetchDistance].entry);
     }

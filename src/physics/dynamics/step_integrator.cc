@@ -228,7 +228,7 @@ std::vector<Impact> WorldImpl::FindImpacts(const StepContext& step,
   // A pair's search costs 0.1-10 us; a chunk this long amortizes taking it.
   constexpr std::size_t kPairsPerChunk = 64;
   impact_searches_.resize(pairs.size());
-  pool_->ParallelFor(pairs.size(), kPairsPerChunk, [&](std::size_t e) {
+  step.pool->ParallelFor(pairs.size(), kPairsPerChunk, [&](std::size_t e) {
     PrefetchAhead(pairs, e, PrefetchManifold);
     ShapePairContact* pair = pairs[e];
     ImpactSearch& search = impact_searches_[e];

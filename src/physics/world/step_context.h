@@ -17,7 +17,6 @@ struct StepContext {
   // The whole step: `settings.time_step`.
   StepContext(const WorldSettings& world_settings, TaskPool* task_pool)
       : dt(world_settings.time_step),
-        inv_dt(1.0 / world_settings.time_step),
         step_dt(world_settings.time_step),
         settings(&world_settings),
         pool(task_pool) {
@@ -30,12 +29,10 @@ struct StepContext {
     assert(h > 0.0 && h <= step_dt);
     StepContext sub = *this;
     sub.dt = h;
-    sub.inv_dt = 1.0 / h;
     return sub;
   }
 
   double dt;       // s, the interval the stages advance (the step, or a sub-step)
-  double inv_dt;   // 1/s
   double step_dt;  // s, the whole step
   const WorldSettings* settings;
   TaskPool* pool;  // settings->threads threads
