@@ -14,6 +14,7 @@
 
 #include "rigid_body_sim/io/convex_decomposition.h"
 #include "rigid_body_sim/io/convex_hull.h"
+#include "rigid_body_sim/io/gazebo_plugins.h"
 #include "rigid_body_sim/io/mesh_loader.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/mass_properties.h"
@@ -193,8 +194,12 @@ struct LoadedModel {
   // one movable joint): the model becomes an articulation.
   bool articulated = false;
   std::vector<std::string> warnings;  // e.g. inertia computed from geometry
+  // The sensors and ROS plugins of its <gazebo> elements that the node
+  // runs (ReadGazeboPlugins), their links and joints checked.
+  GazeboPlugins plugins;
   // What the description asks for that is not simulated, one entry each:
-  // <transmission> and <gazebo><plugin> elements (IgnoredElements).
+  // <transmission> elements and the <gazebo> plugins and sensors that
+  // `plugins` does not hold (IgnoredElements).
   std::vector<std::string> ignored;
 };
 
