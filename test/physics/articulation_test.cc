@@ -272,6 +272,39 @@ TEST(ArticulationTest, ServoHoldsWithinTauOverKAndMotorKeepsItsSpeed) {
   EXPECT_NEAR(world.GetJointStates(id)[0].velocity, 0.5, 5e-3);
 }
 
+// A velocity motor with its own cap (max_effort, a drive's wheel torque)
+// below the joint's effort limit: a 1 kg slide along x, out of gravity's
+// way, driven toward 10 m/s by at most 2 N accelerates at 2 m/s^2, so
+// v = 2 t while it is short of the target; with no cap the 1000 N effort
+// limit gives 1000 dt m/s in one step. A negative cap is refused.
+TEST(ArticulationTest, VelocityMotorAcceleratesAtItsOwnForceCap) {
+  ArticulationDef def;
+  def.fixed_base = true;
+  def.links = {Anchor(), Anchor()};
+  def.joints = {Slider("slide", 0, 1, Vec3::Zero(), Vec3::UnitX())};
+  def.joints[0].lower = -100.0;
+  def.joints[0].upper = 100.0;
+  World capped = MakeWorld();
+  const ArticulationId id = capped.CreateArticulation(def).value();
+  JointCommand drive;
+  drive.mode = JointCommandMode::kVelocity;
+  drive.velocity = 10.0;
+  drive.max_effort = 2.0;
+  ASSERT_TRUE(capped.SetJointCommand(id, 0, drive).ok());
+  for (int step = 0; step < 240; ++step) capped.Step();
+  EXPECT_NEAR(capped.GetJointStates(id)[0].velocity, 2.0 * 1.0, 1e-9);
+  EXPECT_NEAR(capped.GetJointStates(id)[0].effort, 2.0, 1e-9);
+
+  World free = MakeWorld();
+  const ArticulationId uncapped = free.CreateArticulation(def).value();
+  drive.max_effort = 0.0;
+  ASSERT_TRUE(free.SetJointCommand(uncapped, 0, drive).ok());
+  free.Step();
+  EXPECT_NEAR(free.GetJointStates(uncapped)[0].velocity, 1000.0 * kDt, 1e-9);
+  drive.max_effort = -1.0;
+  EXPECT_FALSE(free.SetJointCommand(uncapped, 0, drive).ok());
+}
+
 // A damped pendulum at small amplitude: theta'' + (b / I) theta' +
 // (m g l / I) theta = 0, whose peaks decay as exp(-b t / (2 I)). The rate
 // is measured from the first and the tenth peak, each placed by a parabola

@@ -86,6 +86,10 @@ struct JointCommand {
   double position = 0.0;  // rad or m
   double velocity = 0.0;  // rad/s or m/s; the servo's feed-forward velocity
   double effort = 0.0;    // N m or N
+  // N m or N, >= 0: kVelocity's own force cap below the effort limit (a
+  // motor's torque, e.g. a differential drive's wheelTorque); 0 or inf: the
+  // effort limit alone.
+  double max_effort = 0.0;
 };
 
 // The position servo: a spring of `stiffness` and a damper of `damping`

@@ -113,7 +113,11 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
     // Each of the joints the dof moves may exert its own limit.
     const double effort_bound = joint.effort_scale * def.effort_limit * dt;
     if (joint.command.mode == JointCommandMode::kVelocity) {
-      add(1.0, RowKind::kBounded, joint.command.velocity, effort_bound, 0.0);
+      const double motor_cap = joint.command.max_effort;
+      const double bound = motor_cap > 0.0
+                               ? std::min(effort_bound, joint.effort_scale * motor_cap * dt)
+                               : effort_bound;
+      add(1.0, RowKind::kBounded, joint.command.velocity, bound, 0.0);
     } else if (joint.command.mode == JointCommandMode::kPosition) {
       // The implicit spring-damper as a soft row (Catto 2011, "Soft
       // Constraints"): v + gamma lambda = v_cmd - beta (q - q_cmd) / dt with

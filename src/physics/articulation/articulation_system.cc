@@ -283,6 +283,10 @@ Status ArticulationSystem::SetJointCommand(ArticulationId id, int joint,
       !std::isfinite(command.effort)) {
     return Status::Error("joint command values must be finite");
   }
+  if (!(command.max_effort >= 0.0)) {
+    return Status::Error("joint command max_effort " + FormatNumber(command.max_effort) +
+                         " is outside the allowed range [0, inf] N m or N");
+  }
   ArticulationJoint& target = entry.model.joints[joint];
   if (target.dof < 0 && command.mode != JointCommandMode::kNone) {
     return Status::Error(
