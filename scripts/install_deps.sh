@@ -15,7 +15,7 @@ packages=(
   libros-rosgraph-msgs-dev libtf2-msgs-dev python3-rospy rviz xvfb imagemagick
   python3-geometry-msgs python3-std-msgs python3-std-srvs python3-visualization-msgs
   python3-rosgraph-msgs python3-tf2-msgs python3-diagnostic-msgs python3-sensor-msgs
-  python3-trajectory-msgs libtrajectory-msgs-dev python3-tf2-ros
+  python3-trajectory-msgs libtrajectory-msgs-dev libnav-msgs-dev python3-nav-msgs python3-tf2-ros
   clang libclang-rt-14-dev
   ros-robot-state-publisher tf2-tools python3-yaml
 )

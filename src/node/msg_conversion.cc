@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <variant>
 
@@ -222,6 +223,65 @@ geometry_msgs::Pose PoseToMsg(const Pose& pose) {
   msg.orientation.y = pose.rotation.y();
   msg.orientation.z = pose.rotation.z();
   return msg;
+}
+
+sensor_msgs::LaserScan LaserScanToMsg(const io::LaserSensor& laser,
+                                      const std::vector<double>& ranges, double scan_time) {
+  sensor_msgs::LaserScan scan;
+  scan.angle_min = static_cast<float>(laser.min_angle);
+  scan.angle_max = static_cast<float>(laser.max_angle);
+  scan.angle_increment = static_cast<float>(LaserAngleIncrement(laser));
+  scan.time_increment = 0.0f;  // every ray of a scan is cast at one instant
+  scan.scan_time = static_cast<float>(scan_time);
+  scan.range_min = static_cast<float>(laser.range_min);
+  scan.range_max = static_cast<float>(laser.range_max);
+  scan.ranges.assign(ranges.begin(), ranges.end());
+  scan.intensities.assign(ranges.size(), 0.0f);
+  return scan;
+}
+
+sensor_msgs::PointCloud2 LaserCloudToMsg(const std::vector<Vec3>& directions_sensor,
+                                         const std::vector<double>& ranges) {
+  sensor_msgs::PointCloud2 cloud;
+  sensor_msgs::PointField field;
+  field.datatype = sensor_msgs::PointField::FLOAT32;
+  field.count = 1;
+  for (const char* name : {"x", "y", "z"}) {
+    field.name = name;
+    field.offset = static_cast<std::uint32_t>(4 * cloud.fields.size());
+    cloud.fields.push_back(field);
+  }
+  cloud.point_step = 12;
+  cloud.height = 1;
+  cloud.is_dense = true;
+  for (std::size_t i = 0; i < ranges.size() && i < directions_sensor.size(); ++i) {
+    if (!std::isfinite(ranges[i])) continue;
+    const Eigen::Vector3f point = (ranges[i] * directions_sensor[i]).cast<float>();
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(point.data());
+    cloud.data.insert(cloud.data.end(), bytes, bytes + 12);
+  }
+  cloud.width = static_cast<std::uint32_t>(cloud.data.size() / cloud.point_step);
+  cloud.row_step = cloud.width * cloud.point_step;
+  return cloud;
+}
+
+sensor_msgs::Imu ImuToMsg(const ImuReading& reading) {
+  sensor_msgs::Imu imu;
+  const physics::Quat& q = reading.world_from_sensor;
+  imu.orientation.x = q.x();
+  imu.orientation.y = q.y();
+  imu.orientation.z = q.z();
+  imu.orientation.w = q.w();
+  imu.angular_velocity = VectorToMsg(reading.angular_velocity_sensor);
+  imu.linear_acceleration = VectorToMsg(reading.linear_acceleration_sensor);
+  return imu;
+}
+
+nav_msgs::Odometry OdometryToMsg(const FrameState& state) {
+  nav_msgs::Odometry odometry;
+  odometry.pose.pose = PoseToMsg(state.world_from_frame);
+  odometry.twist.twist = TwistToMsg(state.linear_velocity, state.angular_velocity);
+  return odometry;
 }
 
 geometry_msgs::Twist TwistToMsg(const Vec3& linear_velocity, const Vec3& angular_velocity) {

@@ -283,6 +283,7 @@ std::vector<ParamRange> NodeParamRanges(const NodeOptions& options) {
   auto count = [](auto value) { return static_cast<double>(value); };
   return {
       {"~max_links_per_model", count(options.max_links_per_model), 1, 1e9, ""},
+      {"~sensor_noise_seed", count(options.sensor_noise_seed), 0, 2147483647.0, ""},
       // The articulation holds at most 1000 links (articulation_system.cc).
       {"~max_joints_per_model", count(options.max_joints_per_model), 1, 999, ""},
       {"~max_mesh_triangles", count(options.max_mesh_triangles), 1,
@@ -406,6 +407,7 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"max_step_count", &options->limits.max_step_count},
       {"max_trajectory_points", &options->limits.max_trajectory_points},
       {"max_links_per_model", &options->max_links_per_model},
+      {"sensor_noise_seed", &options->sensor_noise_seed},
       {"max_joints_per_model", &options->max_joints_per_model},
       {"joint_stiffness", &options->servo.stiffness},
       {"joint_damping", &options->servo.damping},

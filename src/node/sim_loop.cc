@@ -6,6 +6,7 @@
 #include <exception>
 #include <string>
 
+#include "node/model_sensors.h"
 #include "rigid_body_sim/node/sim_node.h"
 
 namespace rigid_body_sim::node {
@@ -34,12 +35,14 @@ void SimNode::StepLocked() {
                                  [](const ActiveWrench& w) { return w.remaining_steps <= 0; }),
                   wrenches_.end());
   FollowTrajectoriesLocked();
+  BeforeStepSensorsLocked();
   const Clock::time_point start = Clock::now();
   world_.Step();
   diagnostics_->RecordStep(std::chrono::duration<double>(Clock::now() - start).count(),
                            world_.last_step_profile());
   ++steps_;
   if (!world_.non_finite_bodies().empty()) ReportFrozenLocked();
+  AfterStepSensorsLocked();
 }
 
 void SimNode::ReportFrozenLocked() {
@@ -105,6 +108,7 @@ void SimNode::StepLoop() {
         outbox.clock = world_.time();
       }
       if (outbox.clock) next_clock = now + clock_period;
+      outbox.sensors.swap(pending_sensor_messages_);
       if (now >= next_status) {
         LogStatusLocked(now);
         next_status = now + status_period;

@@ -14,6 +14,7 @@
 
 #include <rosgraph_msgs/Clock.h>
 
+#include "node/model_sensors.h"
 #include "node/ros_uri.h"
 #include "rigid_body_sim/io/mesh_process.h"
 #include "rigid_body_sim/io/xacro_process.h"
@@ -44,6 +45,7 @@ SimNode::SimNode(NodeOptions options, ros::NodeHandle node, ros::NodeHandle priv
       node_(std::move(node)),
       private_node_(std::move(private_node)),
       world_(options_.world),
+      noise_(static_cast<std::uint64_t>(options_.sensor_noise_seed)),
       paused_(options_.paused),
       live_(LiveSettingsOf(options_)) {
   load_options_.default_density = options_.default_density;
@@ -387,6 +389,17 @@ Result<std::vector<std::string>> SimNode::CommitModelLocked(const ModelSpec& spe
           ? CreateArticulationLocked(*prepared->articulation, prepared->loaded, &model)
           : CreateBodyLocked(prepared->def, prepared->loaded, &model);
   if (!created.ok()) return created;
+  Result<std::unique_ptr<ModelSensors>> sensors =
+      MakeSensorsLocked(model, prepared->loaded.plugins);
+  if (!sensors.ok()) {
+    const Status removed = model.articulation.IsValid()
+                               ? world_.DestroyArticulation(model.articulation)
+                               : world_.DestroyBody(model.body);
+    assert(removed.ok());
+    RemoveJointTopics(spec.name);
+    return sensors.status();
+  }
+  if (!(*sensors)->empty()) sensors_[spec.name] = std::move(sensors).value();
   std::vector<std::string> frames;
   for (const io::LinkFrame& link : model.links) frames.push_back(TfFrame(model, link.link_name));
   body_markers_[spec.name] =

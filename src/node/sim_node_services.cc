@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "node/model_sensors.h"
 #include "node/service_reply.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
@@ -84,6 +85,9 @@ bool SimNode::OnDelete(rigid_body_sim::Delete::Request& request,
     };
     wrenches_.erase(std::remove_if(wrenches_.begin(), wrenches_.end(), on_model), wrenches_.end());
     if (model->articulation.IsValid()) RemoveJointTopics(request.name);
+    // Its cmd_vel callback takes no world lock, so its subscriber may go
+    // under it.
+    sensors_.erase(request.name);
     registry_.Remove(request.name);
     frozen_models_.erase(request.name);
     const auto found = body_markers_.find(request.name);
@@ -174,6 +178,7 @@ bool SimNode::OnStep(rigid_body_sim::Step::Request& request,
         FillPeriodicIfDueLocked(Clock::now(), &outbox);
       }
       response.sim_time = world_.time();
+      outbox.sensors.swap(pending_sensor_messages_);
     }
     Publish(std::move(outbox));
     // Callers waiting for the world go first, as in the step loop.

@@ -8,6 +8,7 @@
 
 #include <rosgraph_msgs/Clock.h>
 
+#include "node/model_sensors.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
 #include "rigid_body_sim/node/sim_node.h"
@@ -55,14 +56,22 @@ void SimNode::AppendModelTfLocked(const Model& model, const ros::Time& stamp,
     // A root fixed to the URDF's `world` link: robot_state_publisher
     // publishes world -> root from the URDF; a second parent would split
     // the tree.
-    if (!model.world_link) from_world(0);
+    if (const RunningDiffDrive* drive = RootTfDriveLocked(model); drive != nullptr) {
+      AppendDriveTfLocked(model, *drive, stamp, tf);
+    } else if (!model.world_link) {
+      from_world(0);
+    }
     return;
   }
   if (!model.articulation.IsValid()) {
     for (std::size_t i = 0; i < model.links.size(); ++i) from_world(i);
     return;
   }
-  from_world(0);
+  if (const RunningDiffDrive* drive = RootTfDriveLocked(model); drive != nullptr) {
+    AppendDriveTfLocked(model, *drive, stamp, tf);
+  } else {
+    from_world(0);
+  }
   for (const io::JointInfo& joint : model.joints) {
     if (joint.type == "fixed") continue;
     const physics::Pose world_from_parent =
@@ -201,6 +210,7 @@ void SimNode::Publish(Outbox outbox) {
     contact_markers_publisher_.publish(*outbox.contact_markers);
   }
   if (outbox.body_markers) body_markers_publisher_.publish(*outbox.body_markers);
+  for (const std::function<void()>& publish : outbox.sensors) publish();
   if (outbox.diagnostics) diagnostics_->Publish();
   if (outbox.clock && options_.use_sim_time) {
     std::lock_guard<std::mutex> lock(clock_mutex_);

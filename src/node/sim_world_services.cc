@@ -3,6 +3,7 @@
 #include <cassert>
 #include <string>
 
+#include "node/model_sensors.h"
 #include "node/service_reply.h"
 #include "rigid_body_sim/node/msg_conversion.h"
 #include "rigid_body_sim/node/names.h"
@@ -25,6 +26,7 @@ std::string SimNode::Reset(bool keep_time) {
     }
     wrenches_.clear();
     trajectories_.clear();
+    pending_sensor_messages_.clear();
     frozen_models_.clear();
     if (keep_time) {
       // SetState already dropped every body's contacts and woke it; sim time,
@@ -44,6 +46,7 @@ std::string SimNode::Reset(bool keep_time) {
       }
       ++reset_count_;
     }
+    ResetSensorsLocked();
   }
   wake_.notify_all();
   Publish(std::move(outbox));

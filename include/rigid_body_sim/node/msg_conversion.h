@@ -12,8 +12,12 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <geometry_msgs/Vector3.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/time.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
+#include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <trajectory_msgs/JointTrajectory.h>
 #include <visualization_msgs/Marker.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -25,6 +29,7 @@
 #include "rigid_body_sim/node/joint_requests.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
+#include "rigid_body_sim/node/sensor_models.h"
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/ray.h"
 #include "rigid_body_sim/physics/result.h"
@@ -81,6 +86,21 @@ ros::Time SimTimeToRos(double sim_time);
 
 rigid_body_sim::Contact ContactToMsg(const physics::ContactReport& contact,
                                      const std::string& body_a, const std::string& body_b);
+
+// --- sensors (the caller fills the headers) ---------------------------------
+
+// A scan of LaserRanges: the laser's angles and limits, scan_time the
+// period between scans (s), intensities 0.
+sensor_msgs::LaserScan LaserScanToMsg(const io::LaserSensor& laser,
+                                      const std::vector<double>& ranges, double scan_time);
+// The returns of a multi-row laser as points x, y, z (float32, m) in the
+// sensor frame: range times direction, the rays that hit nothing left out.
+sensor_msgs::PointCloud2 LaserCloudToMsg(const std::vector<physics::Vec3>& directions_sensor,
+                                         const std::vector<double>& ranges);
+// Covariances 0 (known), as the readings are exact but for their noise.
+sensor_msgs::Imu ImuToMsg(const ImuReading& reading);
+// Pose, and twist in the frame the caller chose.
+nav_msgs::Odometry OdometryToMsg(const FrameState& state);
 
 // Links with masses, joints and whether it is static (no success/message).
 void ModelPropertiesToMsg(const Model& model, rigid_body_sim::GetModelProperties::Response* msg);

@@ -65,6 +65,9 @@ struct NodeOptions {
   // requests beyond them are refused (request_validation.h).
   RequestLimits limits;
   int max_links_per_model = 1000;  // ~max_links_per_model: count, >= 1
+  // ~sensor_noise_seed: integer, [0, 2^31 - 1]; seeds the one generator of
+  // every sensor's noise, so a run repeats its readings.
+  int sensor_noise_seed = 0;
   // ~max_joints_per_model: count, [1, 999]: movable joints of one
   // articulated model (io::kDefaultMaxJointsPerModel, 250).
   int max_joints_per_model = io::kDefaultMaxJointsPerModel;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include <dynamic_reconfigure/server.h>
+#include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <std_srvs/SetBool.h>
@@ -48,10 +50,20 @@
 #include "rigid_body_sim/node/joint_trajectory.h"
 #include "rigid_body_sim/node/model_registry.h"
 #include "rigid_body_sim/node/options.h"
+#include "rigid_body_sim/node/sensor_models.h"
 #include "rigid_body_sim/node/sim_diagnostics.h"
 #include "rigid_body_sim/physics/world.h"
 
 namespace rigid_body_sim::node {
+
+struct ModelSensors;
+struct DriveCommand;
+struct RunningLaser;
+struct RunningImu;
+struct RunningBumper;
+struct RunningForceTorque;
+struct RunningOdometry;
+struct RunningDiffDrive;
 
 // Thread model: ROS callbacks run on an AsyncSpinner's threads, the world
 // steps in the loop thread, and one mutex serialises every access to the
@@ -90,7 +102,9 @@ class SimNode {
     std::optional<visualization_msgs::MarkerArray> body_markers;
     std::vector<std::pair<std::string, sensor_msgs::JointState>> joint_states;  // by model
     std::optional<double> clock;                                                // s of sim time
-    bool diagnostics = false;       // a diagnostics window closed
+    bool diagnostics = false;  // a diagnostics window closed
+    // The sensors' messages, each bound to its publisher.
+    std::vector<std::function<void()>> sensors;
     bool tf_is_new_frame = false;   // tf holds only the frames of a new model
     std::uint64_t reset_count = 0;  // resets before the messages were built
   };
@@ -213,6 +227,41 @@ class SimNode {
   // Validated settings into the world and the loop; the caller wakes it.
   physics::Status ApplyLiveSettingsLocked(const LiveSettings& settings);
 
+  // The URDF's Gazebo sensors and plugins (sim_sensors.cc): made at
+  // spawn, their topics under the plugin's or the model's robot namespace.
+  physics::Result<std::unique_ptr<ModelSensors>> MakeSensorsLocked(
+      const Model& model, const io::GazeboPlugins& plugins);
+  ros::NodeHandle SensorHandle(const Model& model, const io::PluginCommon& common) const;
+  physics::Status AddLasersLocked(const Model& model, const io::GazeboPlugins& plugins,
+                                  ModelSensors* sensors);
+  physics::Status AddInertialSensorsLocked(const Model& model, const io::GazeboPlugins& plugins,
+                                           ModelSensors* sensors);
+  physics::Status AddDrivesLocked(const Model& model, const io::GazeboPlugins& plugins,
+                                  ModelSensors* sensors);
+  void OnDriveCommand(const geometry_msgs::Twist& twist, DriveCommand* command);
+  // Around each step (sim_sensor_readings.cc): the states the readings
+  // difference and the drives' wheel commands before it; the readings that
+  // are due after it, into pending_sensor_messages_.
+  void BeforeStepSensorsLocked();
+  void AfterStepSensorsLocked();
+  void DriveWheelsLocked(const Model& model, double dt, RunningDiffDrive* drive);
+  void ReadLaserLocked(const Model& model, const ros::Time& stamp, RunningLaser* laser);
+  void ReadImuLocked(const Model& model, const ros::Time& stamp, RunningImu* imu);
+  void ReadBumperLocked(const ros::Time& stamp, const RunningBumper& bumper);
+  void ReadForceTorqueLocked(const Model& model, const ros::Time& stamp,
+                             const RunningForceTorque& sensor);
+  void ReadGroundTruthLocked(const Model& model, const ros::Time& stamp,
+                             const RunningOdometry& odometry);
+  void ReadDriveOdometryLocked(const Model& model, const ros::Time& stamp, RunningDiffDrive* drive);
+  // The drive's odom -> base: the base's true pose, or the encoders'.
+  FrameState DriveOdometryLocked(const Model& model, const RunningDiffDrive& drive) const;
+  // The drive that publishes the model's odom -> root tf, if any.
+  const RunningDiffDrive* RootTfDriveLocked(const Model& model) const;
+  // world -> odom -> root in place of world -> root.
+  void AppendDriveTfLocked(const Model& model, const RunningDiffDrive& drive,
+                           const ros::Time& stamp, tf2_msgs::TFMessage* tf) const;
+  void ResetSensorsLocked();
+
   void StepLoop();
   // The callers of these hold the mutex.
   void StepLocked();
@@ -298,6 +347,10 @@ class SimNode {
   ModelRegistry registry_;
   std::optional<physics::BodyId> ground_;
   std::vector<ActiveWrench> wrenches_;
+  // By model: the running sensors of models that declare any.
+  std::map<std::string, std::unique_ptr<ModelSensors>> sensors_;
+  std::vector<std::function<void()>> pending_sensor_messages_;
+  SensorNoise noise_;
   // By model; shared, so that a new subscriber's copy (a static terrain's
   // markers hold millions of points) is made without the world lock.
   using MarkerList = std::shared_ptr<const std::vector<visualization_msgs::Marker>>;

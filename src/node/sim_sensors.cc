@@ -1,0 +1,234 @@
+// The URDF's Gazebo sensors and plugins, run by the node: lasers, IMUs,
+// bumpers, force-torque sensors, ground-truth odometry and differential
+// drives. They read after each step, under the world lock, and their
+// messages go out after it is released.
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/WrenchStamped.h>
+
+#include <geometry_msgs/Twist.h>
+
+#include "node/model_sensors.h"
+#include "rigid_body_sim/node/msg_conversion.h"
+#include "rigid_body_sim/node/sim_node.h"
+
+namespace rigid_body_sim::node {
+
+using physics::Pose;
+using physics::Result;
+using physics::Status;
+using physics::Vec3;
+
+bool SensorClock::Due(double now) {
+  if (period <= 0.0) return true;
+  // Sim time is a sum of steps: a reading due at 0.2 s must not wait a
+  // step for the last bits of 48 additions of 1/240.
+  if (now + 1e-9 < next) return false;
+  next += period;
+  if (next <= now) next = now + period;
+  return true;
+}
+
+namespace {
+
+int FindLink(const Model& model, const std::string& name) {
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    if (model.links[i].link_name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// The link and every link below it, through fixed and movable joints.
+std::vector<int> SubtreeLinks(const Model& model, const std::string& top) {
+  std::vector<std::string> names{top};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    for (const io::JointInfo& joint : model.joints) {
+      if (joint.parent_link == names[i]) names.push_back(joint.child_link);
+    }
+  }
+  std::vector<int> links;
+  for (const std::string& name : names) links.push_back(FindLink(model, name));
+  return links;
+}
+
+// A frame a plugin names: a link of the model is its tf frame; any other
+// name (odom, map) is taken as written.
+std::string SensorFrame(const Model& model, const std::string& frame) {
+  return FindLink(model, frame) >= 0 ? TfFrame(model, frame) : frame;
+}
+
+SensorClock StartClock(double rate, double now) {
+  SensorClock clock;
+  clock.period = rate > 0.0 ? 1.0 / rate : 0.0;
+  clock.next = now;
+  return clock;
+}
+
+Status UnknownLink(const io::PluginCommon& common) {
+  return Status::Error("<gazebo> sensor or plugin '" + common.name + "' names link '" +
+                       common.link + "', which the model does not have");
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ModelSensors>> SimNode::MakeSensorsLocked(const Model& model,
+                                                                 const io::GazeboPlugins& plugins) {
+  auto sensors = std::make_unique<ModelSensors>();
+  if (Status status = AddLasersLocked(model, plugins, sensors.get()); !status.ok()) return status;
+  if (Status status = AddInertialSensorsLocked(model, plugins, sensors.get()); !status.ok()) {
+    return status;
+  }
+  if (Status status = AddDrivesLocked(model, plugins, sensors.get()); !status.ok()) return status;
+  return sensors;
+}
+
+ros::NodeHandle SimNode::SensorHandle(const Model& model, const io::PluginCommon& common) const {
+  if (!common.robot_namespace.empty()) {
+    const Result<std::string> resolved = ResolveRobotNamespace(common.robot_namespace);
+    if (resolved.ok()) return ros::NodeHandle(*resolved);
+  }
+  return model.robot_namespace.empty() ? ros::NodeHandle(private_node_, model.name)
+                                       : ros::NodeHandle(model.robot_namespace);
+}
+
+Status SimNode::AddLasersLocked(const Model& model, const io::GazeboPlugins& plugins,
+                                ModelSensors* sensors) {
+  const double now = world_.time();
+  for (const io::LaserSensor& spec : plugins.lasers) {
+    RunningLaser laser;
+    laser.spec = spec;
+    laser.link = FindLink(model, spec.common.link);
+    if (laser.link < 0) return UnknownLink(spec.common);
+    laser.directions_sensor = LaserDirections(spec);
+    laser.frame_id = SensorFrame(model, spec.common.frame_id);
+    ros::NodeHandle handle = SensorHandle(model, spec.common);
+    laser.publisher = spec.point_cloud
+                          ? handle.advertise<sensor_msgs::PointCloud2>(spec.common.topic, 2)
+                          : handle.advertise<sensor_msgs::LaserScan>(spec.common.topic, 2);
+    laser.clock = StartClock(spec.common.update_rate, now);
+    sensors->lasers.push_back(std::move(laser));
+  }
+  return Status::Ok();
+}
+
+Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlugins& plugins,
+                                         ModelSensors* sensors) {
+  const double now = world_.time();
+  for (const io::ImuSensor& spec : plugins.imus) {
+    RunningImu imu;
+    imu.spec = spec;
+    imu.link = FindLink(model, spec.common.link);
+    if (imu.link < 0) return UnknownLink(spec.common);
+    imu.frame_id = SensorFrame(model, spec.common.frame_id);
+    imu.publisher =
+        SensorHandle(model, spec.common).advertise<sensor_msgs::Imu>(spec.common.topic, 10);
+    imu.clock = StartClock(spec.common.update_rate, now);
+    imu.orientation_bias = noise_.DrawBias3(spec.orientation);
+    imu.rate_bias = noise_.DrawBias3(spec.angular_velocity);
+    imu.acceleration_bias = noise_.DrawBias3(spec.linear_acceleration);
+    imu.before = LinkStateFromRoot(LinkStateLocked(model, imu.link), spec.common.link_from_sensor);
+    sensors->imus.push_back(std::move(imu));
+  }
+  for (const io::BumperSensor& spec : plugins.bumpers) {
+    RunningBumper bumper;
+    bumper.spec = spec;
+    if (FindLink(model, spec.common.link) < 0) return UnknownLink(spec.common);
+    bumper.link_frame = FrameName(model.name, spec.common.link);
+    bumper.frame_id = SensorFrame(model, spec.common.frame_id);
+    bumper.publisher =
+        SensorHandle(model, spec.common).advertise<rigid_body_sim::Contacts>(spec.common.topic, 10);
+    bumper.clock = StartClock(spec.common.update_rate, now);
+    sensors->bumpers.push_back(std::move(bumper));
+  }
+  for (const io::ForceTorqueSensor& spec : plugins.force_torque) {
+    RunningForceTorque sensor;
+    sensor.spec = spec;
+    sensor.child = FindLink(model, spec.common.link);
+    if (sensor.child < 0) return UnknownLink(spec.common);
+    sensor.subtree = SubtreeLinks(model, spec.common.link);
+    for (const int link : sensor.subtree) {
+      sensor.subtree_frames.push_back(FrameName(model.name, model.links[link].link_name));
+      sensor.before.push_back(LinkStateLocked(model, link));
+    }
+    sensor.frame_id = SensorFrame(model, spec.common.frame_id);
+    sensor.publisher = SensorHandle(model, spec.common)
+                           .advertise<geometry_msgs::WrenchStamped>(spec.common.topic, 10);
+    sensor.clock = StartClock(spec.common.update_rate, now);
+    sensors->force_torque.push_back(std::move(sensor));
+  }
+  for (const io::GroundTruthOdometry& spec : plugins.odometry) {
+    RunningOdometry odometry;
+    odometry.spec = spec;
+    odometry.link = FindLink(model, spec.common.link);
+    if (odometry.link < 0) return UnknownLink(spec.common);
+    odometry.reference = FindLink(model, spec.common.frame_id);
+    odometry.frame_id =
+        odometry.reference >= 0 ? TfFrame(model, spec.common.frame_id) : options_.world_frame;
+    odometry.child_frame_id = TfFrame(model, spec.common.link);
+    odometry.publisher =
+        SensorHandle(model, spec.common).advertise<nav_msgs::Odometry>(spec.common.topic, 10);
+    odometry.clock = StartClock(spec.common.update_rate, now);
+    sensors->odometry.push_back(std::move(odometry));
+  }
+  return Status::Ok();
+}
+
+Status SimNode::AddDrivesLocked(const Model& model, const io::GazeboPlugins& plugins,
+                                ModelSensors* sensors) {
+  const auto joint_index = [&model](const std::string& name) {
+    const auto found = std::find(model.joint_names.begin(), model.joint_names.end(), name);
+    return found == model.joint_names.end() ? -1
+                                            : static_cast<int>(found - model.joint_names.begin());
+  };
+  for (const io::DiffDrive& spec : plugins.diff_drives) {
+    RunningDiffDrive drive;
+    drive.spec = spec;
+    drive.left = joint_index(spec.left_joint);
+    drive.right = joint_index(spec.right_joint);
+    if (drive.left < 0 || drive.right < 0 || !model.articulation.IsValid()) {
+      return Status::Error("<gazebo> plugin '" + spec.common.name + "' drives joints '" +
+                           spec.left_joint + "' and '" + spec.right_joint +
+                           "', which must be movable joints of an articulated model");
+    }
+    const int base = FindLink(model, spec.robot_base_frame);
+    drive.base = base >= 0 ? base : 0;
+    drive.owns_root_tf = spec.publish_tf && drive.base == 0;
+    drive.odom_frame = model.tf_prefix + spec.odometry_frame;
+    drive.base_frame = TfFrame(model, model.links[drive.base].link_name);
+    const std::vector<physics::JointState> joints = world_.GetJointStates(model.articulation);
+    drive.left_before = joints[drive.left].position;
+    drive.right_before = joints[drive.right].position;
+    drive.command = std::make_shared<DriveCommand>();
+    ros::NodeHandle handle = SensorHandle(model, spec.common);
+    const std::shared_ptr<DriveCommand> command = drive.command;
+    const std::string topic = spec.common.topic;
+    drive.subscriber = handle.subscribe<geometry_msgs::Twist>(
+        topic, 10, [this, command, topic](const geometry_msgs::Twist::ConstPtr& twist) {
+          Guarded(topic.c_str(), [&] { OnDriveCommand(*twist, command.get()); });
+        });
+    drive.publisher = handle.advertise<nav_msgs::Odometry>(spec.odometry_topic, 10);
+    drive.clock = StartClock(spec.common.update_rate, world_.time());
+    sensors->drives.push_back(std::move(drive));
+  }
+  return Status::Ok();
+}
+
+void SimNode::OnDriveCommand(const geometry_msgs::Twist& twist, DriveCommand* command) {
+  if (!std::isfinite(twist.linear.x) || !std::isfinite(twist.angular.z)) {
+    ROS_ERROR("cmd_vel refused, nothing applied: linear.x %g and angular.z %g must be finite",
+              twist.linear.x, twist.angular.z);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(command->mutex);
+  command->linear = twist.linear.x;
+  command->angular = twist.angular.z;
+  command->received = true;
+}
+
+}  // namespace rigid_body_sim::node

@@ -1,0 +1,190 @@
+#!/usr/bin/env python3
+"""The URDF's Gazebo sensors through the node's topics, against closed
+forms: a laser among walls and a post, an IMU, a bumper and ground-truth
+odometry on a resting box, a force-torque sensor at a held arm's shoulder,
+and a differential drive driven by cmd_vel."""
+import math
+import sys
+import threading
+import time
+import unittest
+
+import rospkg
+import rospy
+import rostest
+from geometry_msgs.msg import Pose, Twist, WrenchStamped
+from nav_msgs.msg import Odometry
+from rigid_body_sim.msg import Contacts
+from rigid_body_sim.srv import Delete, GetState, Spawn, SpawnRequest, Step
+from sensor_msgs.msg import Imu, LaserScan
+
+PKG = 'rigid_body_sim'
+SIM = '/rigid_body_sim/'
+G = 9.81
+
+
+def service(name, kind):
+    rospy.wait_for_service(SIM + name, timeout=30.0)
+    return rospy.ServiceProxy(SIM + name, kind, persistent=True)
+
+
+class Latest:
+    """Every message of a topic, kept in order."""
+
+    def __init__(self, topic, kind):
+        self.lock = threading.Lock()
+        self.messages = []
+        self.subscriber = rospy.Subscriber(topic, kind, self.on_message, queue_size=1000)
+
+    def on_message(self, message):
+        with self.lock:
+            self.messages.append(message)
+
+    def wait(self, count, timeout=10.0):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            with self.lock:
+                if len(self.messages) >= count:
+                    return list(self.messages)
+            time.sleep(0.02)
+        with self.lock:
+            return list(self.messages)
+
+
+def box_urdf(name, size, static=True):
+    inertial = ('<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" '
+                'iyz="0"/></inertial>')
+    geometry = '<box size="%g %g %g"/>' % size
+    return ('<robot name="%s"><link name="body">%s<collision><geometry>%s</geometry></collision>'
+            '</link></robot>') % (name, inertial, geometry)
+
+
+def cylinder_urdf(name, radius, length):
+    inertial = ('<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" '
+                'iyz="0"/></inertial>')
+    return ('<robot name="%s"><link name="body">%s<collision><geometry><cylinder radius="%g" '
+            'length="%g"/></geometry></collision></link></robot>') % (name, inertial, radius,
+                                                                     length)
+
+
+class SensorsTest(unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        cls.data = rospkg.RosPack().get_path(PKG) + '/test/data/sensors/'
+        cls.spawn_service = service('spawn', Spawn)
+        cls.delete = service('delete', Delete)
+        cls.step = service('step', Step)
+        cls.get_state = service('get_state', GetState)
+
+    def spawn(self, name, urdf='', urdf_path='', xyz=(0, 0, 0), is_static=False, **kwargs):
+        request = SpawnRequest(name=name, urdf=urdf, urdf_path=urdf_path, is_static=is_static,
+                               friction=-1.0, restitution=-1.0, **kwargs)
+        request.pose = Pose()
+        request.pose.position.x, request.pose.position.y, request.pose.position.z = xyz
+        request.pose.orientation.w = 1.0
+        response = self.spawn_service(request)
+        self.assertTrue(response.success, response.message)
+        self.addCleanup(self.delete, name)
+        return response
+
+    def test_laser_ranges_in_a_known_room(self):
+        # The post's laser is 0.5 m up at the origin; beams along +x, +y,
+        # -x and -y. A wall's face at x = 1.9, a cylinder of radius 0.25 at
+        # y = 1.5 (its face at 1.25), nothing along -x, a box's face at
+        # y = -0.9.
+        self.spawn('wall', urdf=box_urdf('wall', (0.2, 4, 2)), xyz=(2.0, 0, 1), is_static=True)
+        self.spawn('pillar', urdf=cylinder_urdf('pillar', 0.25, 2), xyz=(0, 1.5, 1),
+                   is_static=True)
+        self.spawn('crate', urdf=box_urdf('crate', (1, 0.2, 2)), xyz=(0, -1.0, 1), is_static=True)
+        scans = Latest(SIM + 'laser_post/scan', LaserScan)
+        rospy.sleep(0.5)
+        self.spawn('laser_post', urdf_path=self.data + 'laser_post.urdf')
+        self.step(48)  # 0.2 s: two readings at 10 Hz
+        messages = scans.wait(2)
+        self.assertGreaterEqual(len(messages), 2)
+        scan = messages[-1]
+        self.assertEqual('laser_post/post', scan.header.frame_id)
+        self.assertEqual(4, len(scan.ranges))
+        self.assertAlmostEqual(0.0, scan.angle_min, places=6)
+        self.assertAlmostEqual(math.pi / 2, scan.angle_increment, places=6)
+        self.assertAlmostEqual(0.1, scan.range_min, places=6)
+        self.assertAlmostEqual(5.0, scan.range_max, places=6)
+        # float32 ranges: 1e-6 m is within their precision at these sizes.
+        self.assertAlmostEqual(1.9, scan.ranges[0], delta=1e-6)
+        self.assertAlmostEqual(1.25, scan.ranges[1], delta=1e-6)
+        self.assertEqual(float('inf'), scan.ranges[2])
+        self.assertAlmostEqual(0.9, scan.ranges[3], delta=1e-6)
+
+    def test_imu_bumper_and_truth_on_a_resting_box(self):
+        imus = Latest(SIM + 'imu_box/imu', Imu)
+        bumps = Latest(SIM + 'imu_box/bumper', Contacts)
+        truths = Latest(SIM + 'imu_box/truth', Odometry)
+        rospy.sleep(0.5)
+        self.spawn('imu_box', urdf_path=self.data + 'imu_box.urdf', xyz=(3, 3, 0.1))
+        self.step(240)
+        imu = imus.wait(100)[-1]
+        self.assertEqual('imu_box/base', imu.header.frame_id)
+        self.assertAlmostEqual(G, imu.linear_acceleration.z, delta=1e-6)
+        self.assertAlmostEqual(0.0, imu.linear_acceleration.x, delta=1e-6)
+        self.assertAlmostEqual(0.0, imu.angular_velocity.z, delta=1e-6)
+        self.assertAlmostEqual(1.0, imu.orientation.w, delta=1e-6)
+        bump = bumps.wait(50)[-1]
+        total = sum(contact.normal_force * contact.normal.z for contact in bump.contacts)
+        self.assertTrue(all(contact.body_a == 'imu_box/base' for contact in bump.contacts))
+        self.assertAlmostEqual(2.0 * G, total, delta=0.01 * 2.0 * G)
+        truth = truths.wait(50)[-1]
+        state = self.get_state('imu_box')
+        self.assertEqual('world', truth.header.frame_id)
+        self.assertEqual('imu_box/base', truth.child_frame_id)
+        self.assertAlmostEqual(state.pose.position.z, truth.pose.pose.position.z, delta=1e-9)
+        self.assertAlmostEqual(0.1, truth.pose.pose.position.z, delta=1e-3)
+
+    def test_force_torque_at_a_held_shoulder(self):
+        wrenches = Latest(SIM + 'ft_arm/shoulder_wrench', WrenchStamped)
+        rospy.sleep(0.5)
+        self.spawn('ft_arm', urdf_path=self.data + 'ft_arm.urdf', xyz=(-3, 3, 0), hold=True)
+        self.step(240)
+        wrench = wrenches.wait(50)[-1].wrench
+        # The 2 kg upper arm's centre 0.25 m out, the 1 kg forearm's 0.7 m.
+        weight = 3.0 * G
+        moment = (2.0 * 0.25 + 1.0 * 0.7) * G
+        self.assertAlmostEqual(weight, wrench.force.z, delta=1e-3 * weight)
+        self.assertAlmostEqual(0.0, wrench.force.x, delta=1e-3 * weight)
+        # The support's moment about y lifts the arm: -moment along y.
+        self.assertAlmostEqual(-moment, wrench.torque.y, delta=1e-3 * moment)
+
+    def test_diff_drive_moves_by_cmd_vel_and_its_odometry_agrees(self):
+        odoms = Latest(SIM + 'diff_bot/odom', Odometry)
+        scans = Latest(SIM + 'diff_bot/scan', LaserScan)
+        rospy.sleep(0.5)
+        self.spawn('diff_bot', urdf_path=self.data + 'diff_bot.urdf', xyz=(-3, -3, 0.05))
+        self.step(120)  # settle on its wheels
+        start = self.get_state('diff_bot').pose.position
+        command = rospy.Publisher(SIM + 'diff_bot/cmd_vel', Twist, queue_size=1, latch=True)
+        twist = Twist()
+        twist.linear.x = 0.1
+        command.publish(twist)
+        rospy.sleep(1.0)
+        first = len(odoms.wait(1))
+        self.step(1200)  # 5 s
+        end = self.get_state('diff_bot').pose.position
+        travelled = math.hypot(end.x - start.x, end.y - start.y)
+        self.assertAlmostEqual(0.5, travelled, delta=0.03 * 0.5)
+        odom = odoms.wait(first + 150)[-1]
+        odom_travelled = math.hypot(odom.pose.pose.position.x, odom.pose.pose.position.y)
+        self.assertAlmostEqual(travelled, odom_travelled, delta=0.02 * travelled)
+        self.assertEqual('diff_bot/odom', odom.header.frame_id)
+        self.assertEqual('diff_bot/base_link', odom.child_frame_id)
+        scan = scans.wait(5)[-1]
+        self.assertEqual(360, len(scan.ranges))
+        stamps = [m.header.stamp.to_sec() for m in scans.wait(25)]
+        periods = [b - a for a, b in zip(stamps, stamps[1:])]
+        self.assertTrue(periods)
+        for period in periods:
+            self.assertAlmostEqual(0.2, period, delta=1e-6)
+
+
+if __name__ == '__main__':
+    rospy.init_node('sensors_test')
+    rostest.rosrun(PKG, 'sensors', SensorsTest, sys.argv)
