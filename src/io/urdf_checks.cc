@@ -550,20 +550,6 @@ std::vector<std::string> IgnoredElements(const TiXmlElement& robot) {
        transmission != nullptr; transmission = transmission->NextSiblingElement("transmission")) {
     ignored.push_back("<transmission " + Quoted(attribute(*transmission, "name")) + ">");
   }
-  for (const TiXmlElement* gazebo = robot.FirstChildElement("gazebo"); gazebo != nullptr;
-       gazebo = gazebo->NextSiblingElement("gazebo")) {
-    for (const TiXmlElement* plugin = gazebo->FirstChildElement("plugin"); plugin != nullptr;
-         plugin = plugin->NextSiblingElement("plugin")) {
-      ignored.push_back("<gazebo> plugin " + Quoted(attribute(*plugin, "name")) + " (" +
-                        attribute(*plugin, "filename") + ")");
-    }
-    for (const TiXmlElement* sensor = gazebo->FirstChildElement("sensor"); sensor != nullptr;
-         sensor = sensor->NextSiblingElement("sensor")) {
-      ignored.push_back("<gazebo reference=" + Quoted(attribute(*gazebo, "reference")) +
-                        "> sensor " + Quoted(attribute(*sensor, "name")) + " (" +
-                        attribute(*sensor, "type") + ")");
-    }
-  }
   // Once each: descriptions repeat a transmission per hardware interface
   // (Franka's gives every joint three of the same name).
   std::vector<std::string> unique;

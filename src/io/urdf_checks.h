@@ -50,12 +50,11 @@ bool EveryLinkIsMassless(const TiXmlElement& robot);
 // The model will be static: spawned so, fixed to 'world', or massless.
 bool IsStaticDocument(const TiXmlElement& robot, const UrdfLoadOptions& options);
 
-// One entry per distinct <transmission> (ros_control's; joint commands drive the
-// joints directly) and per <gazebo><plugin> (Gazebo's plugins do not run
-// here) and <gazebo><sensor>; transmissions first, then Gazebo's, each in
-// document order: "<transmission 'NAME'>",
-// "<gazebo> plugin 'NAME' (FILENAME)", "<gazebo reference='LINK'> sensor
-// 'NAME' (TYPE)".
+// One entry per distinct <transmission> (ros_control's; joint commands drive
+// the joints directly), in document order: "<transmission 'NAME'>". The
+// loader appends the <gazebo> plugins and sensors that ReadGazeboPlugins
+// does not hold (gazebo_plugins.h), worded "<gazebo> plugin 'NAME'
+// (FILENAME)" and "<gazebo reference='LINK'> sensor 'NAME' (TYPE)".
 std::vector<std::string> IgnoredElements(const TiXmlElement& robot);
 
 }  // namespace rigid_body_sim::io

@@ -1,6 +1,5 @@
 #include "rigid_body_sim/io/urdf_loader.h"
 
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -20,6 +19,7 @@
 #include <urdf_model/model.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "io/gazebo_plugins.h"
 #include "io/mesh_collision_modes.h"
 #include "io/urdf_checks.h"
 #include "io/urdf_elements.h"
@@ -95,7 +95,10 @@ class ModelBuilder {
       return Result<LoadedModel>::Error("urdfdom rejected the URDF: " +
                                         (reason.empty() ? "no reason given" : reason));
     }
-    return BuildModel(*model);
+    Result<LoadedModel> loaded = BuildModel(*model);
+    if (!loaded.ok()) return loaded;
+    if (Status status = AddGazeboPlugins(*robot, &loaded.value()); !status.ok()) return status;
+    return loaded;
   }
 
  private:
@@ -532,7 +535,7 @@ class ModelBuilder {
   bool static_model_ = false;                   // fixed to `world`, massless, or spawned static
   bool massless_ = false;                       // every link states mass 0
   std::vector<std::string> document_warnings_;  // what reading the XML itself changed
-  std::vector<std::string> ignored_;            // IgnoredElements of the document
+  std::vector<std::string> ignored_;            // IgnoredElements: the transmissions
   UrdfMeshes meshes_;
 };
 

@@ -272,7 +272,7 @@ TEST(UrdfHabitsTest, TransmissionsPluginsAndSensorsAreListedAsIgnored) {
       "<transmission name='tran1'><type>transmission_interface/SimpleTransmission</type>"
       "</transmission><transmission name='tran1'/><gazebo><plugin name='gazebo_ros_control' "
       "filename='libgazebo_ros_control.so'/></gazebo><gazebo reference='base'><sensor "
-      "type='ray' name='lidar'><plugin name='laser' filename='libgazebo_ros_laser.so'/></sensor>"
+      "type='camera' name='cam'><plugin name='camera' filename='libgazebo_ros_camera.so'/></sensor>"
       "</gazebo></robot>";
   const Result<LoadedModel> model = LoadUrdfString(xml, {});
   ASSERT_TRUE(model.ok()) << model.message();
@@ -280,7 +280,7 @@ TEST(UrdfHabitsTest, TransmissionsPluginsAndSensorsAreListedAsIgnored) {
             (std::vector<std::string>{"<transmission 'tran1'>",
                                       "<gazebo> plugin 'gazebo_ros_control' "
                                       "(libgazebo_ros_control.so)",
-                                      "<gazebo reference='base'> sensor 'lidar' (ray)"}));
+                                      "<gazebo reference='base'> sensor 'cam' (camera)"}));
   const Result<LoadedModel> unexpanded =
       LoadUrdfString("<robot name='r'>" + Link("base", Box("${s} 1 1")) + "</robot>", {});
   ASSERT_FALSE(unexpanded.ok());

@@ -32,12 +32,14 @@ struct PluginCommon {
   std::string filename;  // <plugin filename>, e.g. libgazebo_ros_laser.so
   // The link it rides on: <gazebo reference="LINK">, or <bodyName>.
   std::string link;
-  // <sensor><pose> and the plugin's <xyzOffset>/<rpyOffset>, in the link
-  // frame.
+  // <sensor><pose>, in the link frame; identity for a model plugin (whose
+  // <xyzOffset>/<rpyOffset> act on its readings, see ImuSensor and
+  // GroundTruthOdometry).
   physics::Pose link_from_sensor;
   // Hz, >= 0; 0 publishes after every step (SDF's "as fast as possible").
   double update_rate = 0.0;
-  // The plugin's <robotNamespace>; empty: the model's robot namespace.
+  // The plugin's <robotNamespace>; empty: the model's robot namespace (the
+  // spawn service writes its robot_namespace into every plugin without one).
   std::string robot_namespace;
   // As written (<topicName>, <bumperTopicName>, ...); relative to the
   // namespace unless it starts with '/'. Defaults are the plugin's.
@@ -57,11 +59,13 @@ struct LaserSensor {
   int vertical_samples = 1;
   double vertical_min_angle = 0.0;  // rad, elevation
   double vertical_max_angle = 0.0;
-  double range_min = 0.0;  // m, >= 0
-  double range_max = 0.0;  // m, > range_min
+  double range_min = 0.0;         // m, >= 0
+  double range_max = 0.0;         // m, > range_min
   double range_resolution = 0.0;  // m, >= 0; 0 leaves ranges unrounded
-  GaussianNoise noise;            // m, on each range
-  // sensor_msgs/PointCloud2 instead of LaserScan: vertical_samples > 1 or
+  // m, on each range: <ray><noise>, and the block laser's <gaussianNoise>
+  // (which it adds to each point's x, y and z) with their variances added.
+  GaussianNoise noise;
+  // A point cloud instead of sensor_msgs/LaserScan: vertical_samples > 1 or
   // the block laser.
   bool point_cloud = false;
 };
@@ -74,6 +78,9 @@ struct ImuSensor {
   GaussianNoise orientation;          // rad, on each axis of a small rotation
   GaussianNoise angular_velocity;     // rad/s, each axis
   GaussianNoise linear_acceleration;  // m/s^2, each axis
+  // <rpyOffset>: the reported orientation is this times the true one (both
+  // plugins premultiply it; <xyzOffset> moves nothing they publish).
+  physics::Quat orientation_offset = physics::Quat::Identity();
 };
 
 // <sensor type="contact"> with libgazebo_ros_bumper.so: the link's contacts.
@@ -94,14 +101,23 @@ struct ForceTorqueSensor {
 // libgazebo_ros_p3d.so: the true pose and twist of <bodyName>, relative to
 // <frameName> (world, map or another link of the model).
 struct GroundTruthOdometry {
-  PluginCommon common;  // frame_id: the reference frame; link: the body
+  PluginCommon common;  // frame_id: <frameName> as written; link: the body
+  // The link of the model that <frameName> names; empty for world, map,
+  // /world, /map or "": the world frame.
+  std::string reference_link;
   GaussianNoise noise;  // m and m/s, rad and rad/s (<gaussianNoise>)
+  // <xyzOffset> added to the reported position and <rpyOffset>
+  // premultiplying the reported orientation, in the reference frame, as the
+  // plugin applies them.
+  physics::Pose offset;
 };
 
 // libgazebo_ros_diff_drive.so.
 struct DiffDrive {
-  PluginCommon common;  // topic: <commandTopic>; link: the base link
-  std::string left_joint;   // revolute or continuous joints of the model
+  // topic: <commandTopic>; link: the model's root link; frame_id:
+  // odometry_frame.
+  PluginCommon common;
+  std::string left_joint;  // revolute or continuous joints of the model
   std::string right_joint;
   double wheel_separation = 0.34;   // m, > 0
   double wheel_diameter = 0.15;     // m, > 0
@@ -110,11 +126,18 @@ struct DiffDrive {
   std::string odometry_topic = "odom";
   std::string odometry_frame = "odom";
   std::string robot_base_frame = "base_footprint";
-  bool publish_tf = true;            // odometry_frame -> robot_base_frame
+  // <publishTf>: the odometry topic at all (the plugin publishes neither
+  // odometry nor its transform without it).
+  bool publish_odometry = true;
+  // odometry_frame -> robot_base_frame: <publishTf> and <publishOdomTF>.
+  bool publish_tf = true;
   bool publish_wheel_tf = false;
   bool publish_wheel_joint_state = false;
   bool odometry_from_encoders = false;  // <odometrySource>encoder; else world
-  bool legacy_mode = true;              // left and right swapped, as the plugin
+  // <legacyMode>: left and right swapped, as kinetic's plugin did by
+  // default; noetic's removed the mode (gazebo_ros_pkgs #707), so false
+  // unless a description asks for it.
+  bool legacy_mode = false;
 };
 
 struct GazeboPlugins {

@@ -199,7 +199,7 @@ struct LoadedModel {
   GazeboPlugins plugins;
   // What the description asks for that is not simulated, one entry each:
   // <transmission> elements and the <gazebo> plugins and sensors that
-  // `plugins` does not hold (IgnoredElements).
+  // `plugins` does not hold (IgnoredElements, then plugins.ignored).
   std::vector<std::string> ignored;
 };
 
