@@ -17,11 +17,13 @@
 
 namespace rigid_body_sim::node {
 
-// When a sensor reads: every `period` seconds of sim time, or after every
-// step for a period of 0 (an <update_rate> of 0).
+// When a sensor reads: after the first step, then every `period` seconds
+// of sim time, or after every step for a period of 0 (an <update_rate> of
+// 0).
 struct SensorClock {
-  double period = 0.0;  // s
-  double next = 0.0;    // sim time of the next reading, s
+  double period = 0.0;   // s
+  double next = 0.0;     // sim time of the next reading, s
+  bool started = false;  // read once since spawn or reset
   // Whether a reading is due at `now`; if so `next` moves on by a period,
   // or to a period after `now` when the sensor fell behind (a reset).
   bool Due(double now);

@@ -141,6 +141,7 @@ void SimNode::ReadImuLocked(const Model& model, const ros::Time& stamp, RunningI
       LinkStateFromRoot(LinkStateLocked(model, imu->link), imu->spec.common.link_from_sensor);
   ImuReading reading =
       MeasureImu(imu->before, after, world_.settings().time_step, world_.settings().gravity);
+  reading.world_from_sensor = imu->spec.orientation_offset * reading.world_from_sensor;
   const Vec3 tilt = noise_.Apply(Vec3::Zero(), imu->spec.orientation, imu->orientation_bias);
   if (!tilt.isZero()) {
     reading.world_from_sensor =
@@ -240,6 +241,9 @@ void SimNode::ReadGroundTruthLocked(const Model& model, const ros::Time& stamp,
     relative.angular_velocity =
         reference_from_world.rotation * (body.angular_velocity - reference.angular_velocity);
   }
+  relative.world_from_frame.translation += odometry.spec.offset.translation;
+  relative.world_from_frame.rotation =
+      odometry.spec.offset.rotation * relative.world_from_frame.rotation;
   const io::GaussianNoise& noise = odometry.spec.noise;
   relative.world_from_frame.translation =
       noise_.Apply(relative.world_from_frame.translation, noise, Vec3::Zero());
@@ -263,7 +267,7 @@ void SimNode::ReadDriveOdometryLocked(const Model& model, const ros::Time& stamp
                   joints[drive->right].position - drive->right_before, dt, &drive->encoder);
   drive->left_before = joints[drive->left].position;
   drive->right_before = joints[drive->right].position;
-  if (!drive->clock.Due(world_.time())) return;
+  if (!drive->spec.publish_odometry || !drive->clock.Due(world_.time())) return;
   nav_msgs::Odometry message = OdometryToMsg(DriveOdometryLocked(model, *drive));
   if (!drive->spec.odometry_from_encoders) {
     // The plugin's world source reports the twist in the base's frame.
@@ -313,21 +317,20 @@ void SimNode::AppendDriveTfLocked(const Model& model, const RunningDiffDrive& dr
 }
 
 void SimNode::ResetSensorsLocked() {
-  const double now = world_.time();
   for (auto& [name, sensors] : sensors_) {
     const Model* model = registry_.Find(name);
     if (model == nullptr) continue;
-    for (RunningLaser& laser : sensors->lasers) laser.clock.next = now;
+    for (RunningLaser& laser : sensors->lasers) laser.clock.started = false;
     for (RunningImu& imu : sensors->imus) {
-      imu.clock.next = now;
+      imu.clock.started = false;
       imu.before =
           LinkStateFromRoot(LinkStateLocked(*model, imu.link), imu.spec.common.link_from_sensor);
     }
-    for (RunningBumper& bumper : sensors->bumpers) bumper.clock.next = now;
-    for (RunningForceTorque& sensor : sensors->force_torque) sensor.clock.next = now;
-    for (RunningOdometry& odometry : sensors->odometry) odometry.clock.next = now;
+    for (RunningBumper& bumper : sensors->bumpers) bumper.clock.started = false;
+    for (RunningForceTorque& sensor : sensors->force_torque) sensor.clock.started = false;
+    for (RunningOdometry& odometry : sensors->odometry) odometry.clock.started = false;
     for (RunningDiffDrive& drive : sensors->drives) {
-      drive.clock.next = now;
+      drive.clock.started = false;
       drive.encoder = PlanarOdometry();
       drive.wheels = WheelSpeeds();
       std::lock_guard<std::mutex> lock(drive.command->mutex);

@@ -27,6 +27,12 @@ using physics::Vec3;
 
 bool SensorClock::Due(double now) {
   if (period <= 0.0) return true;
+  if (!started) {
+    // The first reading, after the first step, sets the phase.
+    started = true;
+    next = now + period;
+    return true;
+  }
   // Sim time is a sum of steps: a reading due at 0.2 s must not wait a
   // step for the last bits of 48 additions of 1/240.
   if (now + 1e-9 < next) return false;
@@ -36,6 +42,10 @@ bool SensorClock::Due(double now) {
 }
 
 namespace {
+
+// Messages a sensor's publisher holds: a ~step call publishes a chunk's
+// readings at once (100 IMU readings for a second at 100 Hz).
+constexpr int kSensorQueue = 100;
 
 int FindLink(const Model& model, const std::string& name) {
   for (std::size_t i = 0; i < model.links.size(); ++i) {
@@ -63,10 +73,9 @@ std::string SensorFrame(const Model& model, const std::string& frame) {
   return FindLink(model, frame) >= 0 ? TfFrame(model, frame) : frame;
 }
 
-SensorClock StartClock(double rate, double now) {
+SensorClock StartClock(double rate) {
   SensorClock clock;
   clock.period = rate > 0.0 ? 1.0 / rate : 0.0;
-  clock.next = now;
   return clock;
 }
 
@@ -99,7 +108,6 @@ ros::NodeHandle SimNode::SensorHandle(const Model& model, const io::PluginCommon
 
 Status SimNode::AddLasersLocked(const Model& model, const io::GazeboPlugins& plugins,
                                 ModelSensors* sensors) {
-  const double now = world_.time();
   for (const io::LaserSensor& spec : plugins.lasers) {
     RunningLaser laser;
     laser.spec = spec;
@@ -108,10 +116,11 @@ Status SimNode::AddLasersLocked(const Model& model, const io::GazeboPlugins& plu
     laser.directions_sensor = LaserDirections(spec);
     laser.frame_id = SensorFrame(model, spec.common.frame_id);
     ros::NodeHandle handle = SensorHandle(model, spec.common);
-    laser.publisher = spec.point_cloud
-                          ? handle.advertise<sensor_msgs::PointCloud2>(spec.common.topic, 2)
-                          : handle.advertise<sensor_msgs::LaserScan>(spec.common.topic, 2);
-    laser.clock = StartClock(spec.common.update_rate, now);
+    laser.publisher =
+        spec.point_cloud
+            ? handle.advertise<sensor_msgs::PointCloud2>(spec.common.topic, kSensorQueue)
+            : handle.advertise<sensor_msgs::LaserScan>(spec.common.topic, kSensorQueue);
+    laser.clock = StartClock(spec.common.update_rate);
     sensors->lasers.push_back(std::move(laser));
   }
   return Status::Ok();
@@ -119,16 +128,15 @@ Status SimNode::AddLasersLocked(const Model& model, const io::GazeboPlugins& plu
 
 Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlugins& plugins,
                                          ModelSensors* sensors) {
-  const double now = world_.time();
   for (const io::ImuSensor& spec : plugins.imus) {
     RunningImu imu;
     imu.spec = spec;
     imu.link = FindLink(model, spec.common.link);
     if (imu.link < 0) return UnknownLink(spec.common);
     imu.frame_id = SensorFrame(model, spec.common.frame_id);
-    imu.publisher =
-        SensorHandle(model, spec.common).advertise<sensor_msgs::Imu>(spec.common.topic, 10);
-    imu.clock = StartClock(spec.common.update_rate, now);
+    imu.publisher = SensorHandle(model, spec.common)
+                        .advertise<sensor_msgs::Imu>(spec.common.topic, kSensorQueue);
+    imu.clock = StartClock(spec.common.update_rate);
     imu.orientation_bias = noise_.DrawBias3(spec.orientation);
     imu.rate_bias = noise_.DrawBias3(spec.angular_velocity);
     imu.acceleration_bias = noise_.DrawBias3(spec.linear_acceleration);
@@ -141,9 +149,9 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
     if (FindLink(model, spec.common.link) < 0) return UnknownLink(spec.common);
     bumper.link_frame = FrameName(model.name, spec.common.link);
     bumper.frame_id = SensorFrame(model, spec.common.frame_id);
-    bumper.publisher =
-        SensorHandle(model, spec.common).advertise<rigid_body_sim::Contacts>(spec.common.topic, 10);
-    bumper.clock = StartClock(spec.common.update_rate, now);
+    bumper.publisher = SensorHandle(model, spec.common)
+                           .advertise<rigid_body_sim::Contacts>(spec.common.topic, kSensorQueue);
+    bumper.clock = StartClock(spec.common.update_rate);
     sensors->bumpers.push_back(std::move(bumper));
   }
   for (const io::ForceTorqueSensor& spec : plugins.force_torque) {
@@ -157,9 +165,10 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
       sensor.before.push_back(LinkStateLocked(model, link));
     }
     sensor.frame_id = SensorFrame(model, spec.common.frame_id);
-    sensor.publisher = SensorHandle(model, spec.common)
-                           .advertise<geometry_msgs::WrenchStamped>(spec.common.topic, 10);
-    sensor.clock = StartClock(spec.common.update_rate, now);
+    sensor.publisher =
+        SensorHandle(model, spec.common)
+            .advertise<geometry_msgs::WrenchStamped>(spec.common.topic, kSensorQueue);
+    sensor.clock = StartClock(spec.common.update_rate);
     sensors->force_torque.push_back(std::move(sensor));
   }
   for (const io::GroundTruthOdometry& spec : plugins.odometry) {
@@ -167,13 +176,13 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
     odometry.spec = spec;
     odometry.link = FindLink(model, spec.common.link);
     if (odometry.link < 0) return UnknownLink(spec.common);
-    odometry.reference = FindLink(model, spec.common.frame_id);
+    odometry.reference = spec.reference_link.empty() ? -1 : FindLink(model, spec.reference_link);
     odometry.frame_id =
-        odometry.reference >= 0 ? TfFrame(model, spec.common.frame_id) : options_.world_frame;
+        odometry.reference >= 0 ? TfFrame(model, spec.reference_link) : options_.world_frame;
     odometry.child_frame_id = TfFrame(model, spec.common.link);
-    odometry.publisher =
-        SensorHandle(model, spec.common).advertise<nav_msgs::Odometry>(spec.common.topic, 10);
-    odometry.clock = StartClock(spec.common.update_rate, now);
+    odometry.publisher = SensorHandle(model, spec.common)
+                             .advertise<nav_msgs::Odometry>(spec.common.topic, kSensorQueue);
+    odometry.clock = StartClock(spec.common.update_rate);
     sensors->odometry.push_back(std::move(odometry));
   }
   return Status::Ok();
@@ -198,7 +207,7 @@ Status SimNode::AddDrivesLocked(const Model& model, const io::GazeboPlugins& plu
     }
     const int base = FindLink(model, spec.robot_base_frame);
     drive.base = base >= 0 ? base : 0;
-    drive.owns_root_tf = spec.publish_tf && drive.base == 0;
+    drive.owns_root_tf = spec.publish_odometry && spec.publish_tf && drive.base == 0;
     drive.odom_frame = model.tf_prefix + spec.odometry_frame;
     drive.base_frame = TfFrame(model, model.links[drive.base].link_name);
     const std::vector<physics::JointState> joints = world_.GetJointStates(model.articulation);
@@ -212,8 +221,8 @@ Status SimNode::AddDrivesLocked(const Model& model, const io::GazeboPlugins& plu
         topic, 10, [this, command, topic](const geometry_msgs::Twist::ConstPtr& twist) {
           Guarded(topic.c_str(), [&] { OnDriveCommand(*twist, command.get()); });
         });
-    drive.publisher = handle.advertise<nav_msgs::Odometry>(spec.odometry_topic, 10);
-    drive.clock = StartClock(spec.common.update_rate, world_.time());
+    drive.publisher = handle.advertise<nav_msgs::Odometry>(spec.odometry_topic, kSensorQueue);
+    drive.clock = StartClock(spec.common.update_rate);
     sensors->drives.push_back(std::move(drive));
   }
   return Status::Ok();

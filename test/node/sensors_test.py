@@ -40,6 +40,15 @@ class Latest:
         with self.lock:
             self.messages.append(message)
 
+    def connect(self, timeout=10.0):
+        """Waits until a publisher is connected, so no message is missed."""
+        deadline = time.time() + timeout
+        while time.time() < deadline and self.subscriber.get_num_connections() == 0:
+            time.sleep(0.02)
+        # rospy counts the connection before the publisher has added it.
+        time.sleep(0.5)
+        return self.subscriber.get_num_connections() > 0
+
     def wait(self, count, timeout=10.0):
         deadline = time.time() + timeout
         while time.time() < deadline:
@@ -98,8 +107,9 @@ class SensorsTest(unittest.TestCase):
                    is_static=True)
         self.spawn('crate', urdf=box_urdf('crate', (1, 0.2, 2)), xyz=(0, -1.0, 1), is_static=True)
         scans = Latest(SIM + 'laser_post/scan', LaserScan)
-        rospy.sleep(0.5)
+        time.sleep(0.5)
         self.spawn('laser_post', urdf_path=self.data + 'laser_post.urdf')
+        self.assertTrue(scans.connect())
         self.step(48)  # 0.2 s: two readings at 10 Hz
         messages = scans.wait(2)
         self.assertGreaterEqual(len(messages), 2)
@@ -120,8 +130,10 @@ class SensorsTest(unittest.TestCase):
         imus = Latest(SIM + 'imu_box/imu', Imu)
         bumps = Latest(SIM + 'imu_box/bumper', Contacts)
         truths = Latest(SIM + 'imu_box/truth', Odometry)
-        rospy.sleep(0.5)
+        time.sleep(0.5)
         self.spawn('imu_box', urdf_path=self.data + 'imu_box.urdf', xyz=(3, 3, 0.1))
+        for topic in (imus, bumps, truths):
+            self.assertTrue(topic.connect())
         self.step(240)
         imu = imus.wait(100)[-1]
         self.assertEqual('imu_box/base', imu.header.frame_id)
@@ -142,8 +154,9 @@ class SensorsTest(unittest.TestCase):
 
     def test_force_torque_at_a_held_shoulder(self):
         wrenches = Latest(SIM + 'ft_arm/shoulder_wrench', WrenchStamped)
-        rospy.sleep(0.5)
+        time.sleep(0.5)
         self.spawn('ft_arm', urdf_path=self.data + 'ft_arm.urdf', xyz=(-3, 3, 0), hold=True)
+        self.assertTrue(wrenches.connect())
         self.step(240)
         wrench = wrenches.wait(50)[-1].wrench
         # The 2 kg upper arm's centre 0.25 m out, the 1 kg forearm's 0.7 m.
@@ -157,15 +170,16 @@ class SensorsTest(unittest.TestCase):
     def test_diff_drive_moves_by_cmd_vel_and_its_odometry_agrees(self):
         odoms = Latest(SIM + 'diff_bot/odom', Odometry)
         scans = Latest(SIM + 'diff_bot/scan', LaserScan)
-        rospy.sleep(0.5)
+        time.sleep(0.5)
         self.spawn('diff_bot', urdf_path=self.data + 'diff_bot.urdf', xyz=(-3, -3, 0.05))
+        self.assertTrue(odoms.connect() and scans.connect())
         self.step(120)  # settle on its wheels
         start = self.get_state('diff_bot').pose.position
         command = rospy.Publisher(SIM + 'diff_bot/cmd_vel', Twist, queue_size=1, latch=True)
         twist = Twist()
         twist.linear.x = 0.1
         command.publish(twist)
-        rospy.sleep(1.0)
+        time.sleep(1.0)
         first = len(odoms.wait(1))
         self.step(1200)  # 5 s
         end = self.get_state('diff_bot').pose.position
