@@ -23,11 +23,13 @@ CATKIN := catkin_make -C $(WS) -DPYTHON_EXECUTABLE=/usr/bin/python3 \
 # The demo scene without rviz for DEMO_SECONDS of real time, showing the
 # node's log (its status line comes every 5 s). Succeeds when the node
 # logged at least one status line.
+# DEMO_LAUNCH=drive_demo.launch runs the drive demo instead.
 DEMO_SECONDS ?= 20
+DEMO_LAUNCH ?= demo.launch
 demo: build
-	@echo "[demo] roslaunch rigid_body_sim demo.launch for $(DEMO_SECONDS) s (rviz:=true adds rviz)"
+	@echo "[demo] roslaunch rigid_body_sim $(DEMO_LAUNCH) for $(DEMO_SECONDS) s (rviz:=true adds rviz)"
 	@set +e; source $(WS)/devel/setup.bash; \
-	  timeout --signal=INT --kill-after=10 $(DEMO_SECONDS) roslaunch rigid_body_sim demo.launch 2>&1 \
+	  timeout --signal=INT --kill-after=10 $(DEMO_SECONDS) roslaunch rigid_body_sim $(DEMO_LAUNCH) 2>&1 \
 	  | sed -u 's/\x1b\[[0-9;]*m//g' | grep --line-buffered -E '^\[ *(INFO|WARN|ERROR|FATAL)\]' \
 	  | tee $(WS)/demo.log; \
 	  grep -q 'sim time' $(WS)/demo.log
@@ -174,7 +176,8 @@ bench: deps
 	cmake -S $(ROOT) -B $(BENCH_BUILD) -DRBS_CORE_ONLY=ON -DRBS_BENCH=ON -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" > /dev/null
 	cmake --build $(BENCH_BUILD) -j$(JOBS) \
-	  --target physics_bench hull_bench narrow_phase_bench broad_phase_bench chain_scaling_bench
+	  --target physics_bench hull_bench narrow_phase_bench broad_phase_bench chain_scaling_bench \
+	  ray_bench
 	mkdir -p $(ROOT)/bench/results
 	@echo "[bench] $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $$(date -u '+%F %H:%M UTC')"
 	$(BENCH_BUILD)/physics_bench --runs $(BENCH_RUNS) --scale $(BENCH_SCALE) \
@@ -187,6 +190,7 @@ bench: deps
 	$(BENCH_BUILD)/narrow_phase_bench 200000
 	$(BENCH_BUILD)/broad_phase_bench 30
 	$(BENCH_BUILD)/chain_scaling_bench 480
+	$(BENCH_BUILD)/ray_bench 100000
 	python3 $(ROOT)/bench/plot.py $(ROOT)/bench/results/latest.csv $(ROOT)/bench/results/ms_per_step.png
 	@echo "[bench] ours against Bullet, wall clock and per awake step (bench/ratios.py):"
 	@python3 $(ROOT)/bench/ratios.py $(ROOT)/bench/results/latest.csv

@@ -12,6 +12,7 @@ import unittest
 import rospkg
 import rospy
 import rostest
+import tf2_ros
 from geometry_msgs.msg import Pose, Twist, WrenchStamped
 from nav_msgs.msg import Odometry
 from rigid_body_sim.msg import Contacts
@@ -197,6 +198,56 @@ class SensorsTest(unittest.TestCase):
         self.assertTrue(periods)
         for period in periods:
             self.assertAlmostEqual(0.2, period, delta=1e-6)
+
+    def test_rover_xacro_drives_senses_and_publishes_one_tf_tree(self):
+        """The drive demo's rover, from its xacro with a Gazebo include, as a
+        TurtleBot3 user drives one: its topics under the spawn's robot
+        namespace, as Gazebo puts them."""
+        odoms = Latest('/rover_test/odom', Odometry)
+        scans = Latest('/rover_test/scan', LaserScan)
+        imus = Latest('/rover_test/imu', Imu)
+        buffer = tf2_ros.Buffer()
+        listener = tf2_ros.TransformListener(buffer)
+        package = rospkg.RosPack().get_path(PKG)
+        self.spawn('rover_test', urdf_path=package + '/urdf/rover/rover.urdf.xacro',
+                   xyz=(3, -3, 0), robot_namespace='rover_test')
+        self.assertTrue(odoms.connect() and scans.connect() and imus.connect())
+        self.step(240)  # settle on its wheels and caster
+        imu = imus.wait(200)[-1]
+        self.assertAlmostEqual(G, imu.linear_acceleration.z, delta=1e-3)
+        start = self.get_state('rover_test').pose.position
+        command = rospy.Publisher('/rover_test/cmd_vel', Twist, queue_size=1, latch=True)
+        twist = Twist()
+        twist.linear.x = 0.1
+        command.publish(twist)
+        time.sleep(1.0)
+        first = len(odoms.wait(1))
+        self.step(1200)  # 5 s
+        end = self.get_state('rover_test').pose.position
+        travelled = math.hypot(end.x - start.x, end.y - start.y)
+        self.assertAlmostEqual(0.5, travelled, delta=0.03 * 0.5)
+        # The world source: odom is the world frame, so odom's pose is the
+        # footprint's true pose.
+        odom = odoms.wait(first + 150)[-1]
+        self.assertAlmostEqual(end.x, odom.pose.pose.position.x, delta=0.02 * travelled)
+        self.assertAlmostEqual(end.y, odom.pose.pose.position.y, delta=0.02 * travelled)
+        self.assertEqual('rover_test/odom', odom.header.frame_id)
+        self.assertEqual('rover_test/base_footprint', odom.child_frame_id)
+        scan = scans.wait(5)[-1]
+        self.assertEqual(360, len(scan.ranges))
+        self.assertEqual('rover_test/base_scan', scan.header.frame_id)
+        # One tree: world -> rover_test/odom -> rover_test/base_footprint puts
+        # the footprint where the node's own state says.
+        deadline = time.time() + 10.0
+        frame = 'rover_test/base_footprint'
+        while time.time() < deadline and not buffer.can_transform('world', frame, rospy.Time(0)):
+            time.sleep(0.05)
+        transform = buffer.lookup_transform('world', frame, rospy.Time(0)).transform
+        self.assertAlmostEqual(end.x, transform.translation.x, delta=1e-3)
+        self.assertAlmostEqual(end.y, transform.translation.y, delta=1e-3)
+        self.assertEqual('world', buffer.lookup_transform(
+            'world', 'rover_test/odom', rospy.Time(0)).header.frame_id)
+        del listener
 
 
 if __name__ == '__main__':
