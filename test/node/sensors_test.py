@@ -17,7 +17,7 @@ from geometry_msgs.msg import Pose, Twist, WrenchStamped
 from nav_msgs.msg import Odometry
 from rigid_body_sim.msg import Contacts
 from rigid_body_sim.srv import Delete, GetState, Spawn, SpawnRequest, Step
-from sensor_msgs.msg import Imu, LaserScan
+from sensor_msgs.msg import Imu, JointState, LaserScan
 
 PKG = 'rigid_body_sim'
 SIM = '/rigid_body_sim/'
@@ -152,6 +152,24 @@ class SensorsTest(unittest.TestCase):
         self.assertEqual('imu_box/base', truth.child_frame_id)
         self.assertAlmostEqual(state.pose.position.z, truth.pose.pose.position.z, delta=1e-9)
         self.assertAlmostEqual(0.1, truth.pose.pose.position.z, delta=1e-3)
+
+    def test_imu_on_a_turntable_reads_the_rate_and_the_centripetal_acceleration(self):
+        imus = Latest(SIM + 'turntable/imu', Imu)
+        self.spawn('turntable', urdf_path=self.data + 'turntable.urdf', xyz=(3, -3, 0))
+        self.assertTrue(imus.connect())
+        command = rospy.Publisher(SIM + 'turntable/joint_command', JointState, queue_size=1,
+                                  latch=True)
+        time.sleep(0.5)
+        command.publish(JointState(name=['spin'], velocity=[2.0]))
+        time.sleep(1.0)
+        self.step(480)  # 2 s: up to speed within a step or two (100 N m on 0.75 kg m^2)
+        imu = imus.wait(100)[-1]
+        w, r = 2.0, 0.5
+        self.assertAlmostEqual(w, imu.angular_velocity.z, delta=1e-4 * w)
+        # Toward the axis: the sensor's -x.
+        self.assertAlmostEqual(-w * w * r, imu.linear_acceleration.x, delta=1e-4 * w * w * r)
+        self.assertAlmostEqual(0.0, imu.linear_acceleration.y, delta=1e-4 * w * w * r)
+        self.assertAlmostEqual(G, imu.linear_acceleration.z, delta=1e-4 * G)
 
     def test_force_torque_at_a_held_shoulder(self):
         wrenches = Latest(SIM + 'ft_arm/shoulder_wrench', WrenchStamped)
