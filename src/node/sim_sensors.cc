@@ -43,10 +43,6 @@ bool SensorClock::Due(double now) {
 
 namespace {
 
-// Messages a sensor's publisher holds: a ~step call publishes a chunk's
-// readings at once (100 IMU readings for a second at 100 Hz).
-constexpr int kSensorQueue = 100;
-
 int FindLink(const Model& model, const std::string& name) {
   for (std::size_t i = 0; i < model.links.size(); ++i) {
     if (model.links[i].link_name == name) return static_cast<int>(i);
@@ -115,11 +111,9 @@ Status SimNode::AddLasersLocked(const Model& model, const io::GazeboPlugins& plu
     if (laser.link < 0) return UnknownLink(spec.common);
     laser.directions_sensor = LaserDirections(spec);
     laser.frame_id = SensorFrame(model, spec.common.frame_id);
-    ros::NodeHandle handle = SensorHandle(model, spec.common);
-    laser.publisher =
-        spec.point_cloud
-            ? handle.advertise<sensor_msgs::PointCloud2>(spec.common.topic, kSensorQueue)
-            : handle.advertise<sensor_msgs::LaserScan>(spec.common.topic, kSensorQueue);
+    laser.publisher = spec.point_cloud
+                          ? AdvertiseSensor<sensor_msgs::PointCloud2>(model, spec.common)
+                          : AdvertiseSensor<sensor_msgs::LaserScan>(model, spec.common);
     laser.clock = StartClock(spec.common.update_rate);
     sensors->lasers.push_back(std::move(laser));
   }
@@ -134,8 +128,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
     imu.link = FindLink(model, spec.common.link);
     if (imu.link < 0) return UnknownLink(spec.common);
     imu.frame_id = SensorFrame(model, spec.common.frame_id);
-    imu.publisher = SensorHandle(model, spec.common)
-                        .advertise<sensor_msgs::Imu>(spec.common.topic, kSensorQueue);
+    imu.publisher = AdvertiseSensor<sensor_msgs::Imu>(model, spec.common);
     imu.clock = StartClock(spec.common.update_rate);
     imu.orientation_bias = noise_.DrawBias3(spec.orientation);
     imu.rate_bias = noise_.DrawBias3(spec.angular_velocity);
@@ -149,8 +142,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
     if (FindLink(model, spec.common.link) < 0) return UnknownLink(spec.common);
     bumper.link_frame = FrameName(model.name, spec.common.link);
     bumper.frame_id = SensorFrame(model, spec.common.frame_id);
-    bumper.publisher = SensorHandle(model, spec.common)
-                           .advertise<rigid_body_sim::Contacts>(spec.common.topic, kSensorQueue);
+    bumper.publisher = AdvertiseSensor<rigid_body_sim::Contacts>(model, spec.common);
     bumper.clock = StartClock(spec.common.update_rate);
     sensors->bumpers.push_back(std::move(bumper));
   }
@@ -165,9 +157,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
       sensor.before.push_back(LinkStateLocked(model, link));
     }
     sensor.frame_id = SensorFrame(model, spec.common.frame_id);
-    sensor.publisher =
-        SensorHandle(model, spec.common)
-            .advertise<geometry_msgs::WrenchStamped>(spec.common.topic, kSensorQueue);
+    sensor.publisher = AdvertiseSensor<geometry_msgs::WrenchStamped>(model, spec.common);
     sensor.clock = StartClock(spec.common.update_rate);
     sensors->force_torque.push_back(std::move(sensor));
   }
@@ -180,8 +170,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
     odometry.frame_id =
         odometry.reference >= 0 ? TfFrame(model, spec.reference_link) : options_.world_frame;
     odometry.child_frame_id = TfFrame(model, spec.common.link);
-    odometry.publisher = SensorHandle(model, spec.common)
-                             .advertise<nav_msgs::Odometry>(spec.common.topic, kSensorQueue);
+    odometry.publisher = AdvertiseSensor<nav_msgs::Odometry>(model, spec.common);
     odometry.clock = StartClock(spec.common.update_rate);
     sensors->odometry.push_back(std::move(odometry));
   }

@@ -98,6 +98,22 @@ class SensorsTest(unittest.TestCase):
         self.addCleanup(self.delete, name)
         return response
 
+    def drive(self, name, namespace, odoms):
+        """Drives the model at 0.1 m/s by cmd_vel for 5 s (1200 steps), and
+        returns where it ends, the distance it travelled and its last
+        odometry."""
+        start = self.get_state(name).pose.position
+        command = rospy.Publisher(namespace + '/cmd_vel', Twist, queue_size=1, latch=True)
+        twist = Twist()
+        twist.linear.x = 0.1
+        command.publish(twist)
+        time.sleep(1.0)
+        first = len(odoms.wait(1))
+        self.step(1200)
+        end = self.get_state(name).pose.position
+        travelled = math.hypot(end.x - start.x, end.y - start.y)
+        return end, travelled, odoms.wait(first + 150)[-1]
+
     def test_laser_ranges_in_a_known_room(self):
         # The post's laser is 0.5 m up at the origin; beams along +x, +y,
         # -x and -y. A wall's face at x = 1.9, a cylinder of radius 0.25 at
@@ -193,18 +209,8 @@ class SensorsTest(unittest.TestCase):
         self.spawn('diff_bot', urdf_path=self.data + 'diff_bot.urdf', xyz=(-3, -3, 0.05))
         self.assertTrue(odoms.connect() and scans.connect())
         self.step(120)  # settle on its wheels
-        start = self.get_state('diff_bot').pose.position
-        command = rospy.Publisher(SIM + 'diff_bot/cmd_vel', Twist, queue_size=1, latch=True)
-        twist = Twist()
-        twist.linear.x = 0.1
-        command.publish(twist)
-        time.sleep(1.0)
-        first = len(odoms.wait(1))
-        self.step(1200)  # 5 s
-        end = self.get_state('diff_bot').pose.position
-        travelled = math.hypot(end.x - start.x, end.y - start.y)
+        _, travelled, odom = self.drive('diff_bot', SIM + 'diff_bot', odoms)
         self.assertAlmostEqual(0.5, travelled, delta=0.03 * 0.5)
-        odom = odoms.wait(first + 150)[-1]
         odom_travelled = math.hypot(odom.pose.pose.position.x, odom.pose.pose.position.y)
         self.assertAlmostEqual(travelled, odom_travelled, delta=0.02 * travelled)
         self.assertEqual('diff_bot/odom', odom.header.frame_id)
@@ -233,20 +239,10 @@ class SensorsTest(unittest.TestCase):
         self.step(240)  # settle on its wheels and caster
         imu = imus.wait(200)[-1]
         self.assertAlmostEqual(G, imu.linear_acceleration.z, delta=1e-3)
-        start = self.get_state('rover_test').pose.position
-        command = rospy.Publisher('/rover_test/cmd_vel', Twist, queue_size=1, latch=True)
-        twist = Twist()
-        twist.linear.x = 0.1
-        command.publish(twist)
-        time.sleep(1.0)
-        first = len(odoms.wait(1))
-        self.step(1200)  # 5 s
-        end = self.get_state('rover_test').pose.position
-        travelled = math.hypot(end.x - start.x, end.y - start.y)
+        end, travelled, odom = self.drive('rover_test', '/rover_test', odoms)
         self.assertAlmostEqual(0.5, travelled, delta=0.03 * 0.5)
         # The world source: odom is the world frame, so odom's pose is the
         # footprint's true pose.
-        odom = odoms.wait(first + 150)[-1]
         self.assertAlmostEqual(end.x, odom.pose.pose.position.x, delta=0.02 * travelled)
         self.assertAlmostEqual(end.y, odom.pose.pose.position.y, delta=0.02 * travelled)
         self.assertEqual('rover_test/odom', odom.header.frame_id)

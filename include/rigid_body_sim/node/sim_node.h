@@ -232,6 +232,14 @@ class SimNode {
   physics::Result<std::unique_ptr<ModelSensors>> MakeSensorsLocked(
       const Model& model, const io::GazeboPlugins& plugins);
   ros::NodeHandle SensorHandle(const Model& model, const io::PluginCommon& common) const;
+  // Messages a sensor's publisher holds: a ~step call publishes a chunk's
+  // readings at once (100 IMU readings for a second at 100 Hz).
+  static constexpr int kSensorQueue = 100;
+  // The sensor's topic in its namespace.
+  template <typename Message>
+  ros::Publisher AdvertiseSensor(const Model& model, const io::PluginCommon& common) const {
+    return SensorHandle(model, common).advertise<Message>(common.topic, kSensorQueue);
+  }
   physics::Status AddLasersLocked(const Model& model, const io::GazeboPlugins& plugins,
                                   ModelSensors* sensors);
   physics::Status AddInertialSensorsLocked(const Model& model, const io::GazeboPlugins& plugins,
