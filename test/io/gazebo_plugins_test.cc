@@ -32,84 +32,74 @@ std::string Joint(const std::string& name, const std::string& type, const std::s
          "'/><child link='" + child + "'/><origin xyz='" + xyz + "'/><axis xyz='0 1 0'/></joint>";
 }
 
-// TurtleBot3 burger (turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro
-// and turtlebot3_burger.gazebo.xacro, expanded), its laser with the
-// sensor's <update_rate>5</update_rate> of the published versions that
-// have one.
-const char kBurgerLinks[] = R"(
+// A small differential-drive robot written as the mobile-robot descriptions
+// Gazebo users bring are (a footprint root, wheels on continuous joints, a
+// caster, an IMU link and a laser link merged by fixed joints), with the
+// elements those descriptions carry besides the ones read: materials,
+// contact gains, a plugin-less <sensor type="imu">, a <serviceName>, a
+// <rosDebugLevel>, an <imu><noise> block inside the IMU model plugin and
+// an <update_rate> inside the laser plugin.
+const char kRoverLinks[] = R"(
   <link name="base_footprint"/>
   <joint name="base_joint" type="fixed">
-    <parent link="base_footprint"/><child link="base_link"/><origin xyz="0 0 0.010" rpy="0 0 0"/>
+    <parent link="base_footprint"/><child link="base_link"/><origin xyz="0 0 0.02"/>
   </joint>
   <link name="base_link">
-    <collision><origin xyz="-0.032 0 0.070" rpy="0 0 0"/>
-      <geometry><box size="0.140 0.140 0.143"/></geometry></collision>
-    <inertial><origin xyz="0 0 0" rpy="0 0 0"/><mass value="8.2573504e-01"/>
-      <inertia ixx="2.2124416e-03" ixy="-1.2294101e-05" ixz="3.4938785e-05"
-               iyy="2.1193702e-03" iyz="-5.0120904e-06" izz="2.0064271e-03"/></inertial>
+    <collision><origin xyz="-0.05 0 0.1"/><geometry><box size="0.3 0.25 0.15"/></geometry></collision>
+    <inertial><mass value="3.5"/><inertia ixx="0.03" iyy="0.04" izz="0.05"/></inertial>
   </link>
   <joint name="wheel_left_joint" type="continuous">
     <parent link="base_link"/><child link="wheel_left_link"/>
-    <origin xyz="0.0 0.08 0.023" rpy="-1.57 0 0"/><axis xyz="0 0 1"/>
+    <origin xyz="0 0.12 0.03" rpy="-1.5707963 0 0"/><axis xyz="0 0 1"/>
   </joint>
   <link name="wheel_left_link">
-    <collision><origin xyz="0 0 0" rpy="0 0 0"/>
-      <geometry><cylinder length="0.018" radius="0.033"/></geometry></collision>
-    <inertial><origin xyz="0 0 0"/><mass value="2.8498940e-02"/>
-      <inertia ixx="1.1175580e-05" ixy="-4.2369783e-11" ixz="-5.9381719e-09"
-               iyy="1.1192413e-05" iyz="-1.4400107e-11" izz="2.0712558e-05"/></inertial>
+    <collision><geometry><cylinder length="0.025" radius="0.05"/></geometry></collision>
+    <inertial><mass value="0.1"/><inertia ixx="7e-5" iyy="7e-5" izz="1.25e-4"/></inertial>
   </link>
   <joint name="wheel_right_joint" type="continuous">
     <parent link="base_link"/><child link="wheel_right_link"/>
-    <origin xyz="0.0 -0.080 0.023" rpy="-1.57 0 0"/><axis xyz="0 0 1"/>
+    <origin xyz="0 -0.12 0.03" rpy="-1.5707963 0 0"/><axis xyz="0 0 1"/>
   </joint>
   <link name="wheel_right_link">
-    <collision><origin xyz="0 0 0" rpy="0 0 0"/>
-      <geometry><cylinder length="0.018" radius="0.033"/></geometry></collision>
-    <inertial><origin xyz="0 0 0"/><mass value="2.8498940e-02"/>
-      <inertia ixx="1.1175580e-05" ixy="-4.2369783e-11" ixz="-5.9381719e-09"
-               iyy="1.1192413e-05" iyz="-1.4400107e-11" izz="2.0712558e-05"/></inertial>
+    <collision><geometry><cylinder length="0.025" radius="0.05"/></geometry></collision>
+    <inertial><mass value="0.1"/><inertia ixx="7e-5" iyy="7e-5" izz="1.25e-4"/></inertial>
   </link>
   <joint name="caster_back_joint" type="fixed">
-    <parent link="base_link"/><child link="caster_back_link"/>
-    <origin xyz="-0.081 0 -0.004" rpy="-1.57 0 0"/>
+    <parent link="base_link"/><child link="caster_back_link"/><origin xyz="-0.16 0 -0.01"/>
   </joint>
   <link name="caster_back_link">
-    <collision><origin xyz="0 0.001 0" rpy="0 0 0"/>
-      <geometry><box size="0.030 0.009 0.020"/></geometry></collision>
-    <inertial><mass value="0.005"/><inertia ixx="0.001" iyy="0.001" izz="0.001"/></inertial>
+    <collision><geometry><sphere radius="0.01"/></geometry></collision>
+    <inertial><mass value="0.01"/><inertia ixx="1e-6" iyy="1e-6" izz="1e-6"/></inertial>
   </link>
   <joint name="imu_joint" type="fixed">
-    <parent link="base_link"/><child link="imu_link"/><origin xyz="-0.032 0 0.068" rpy="0 0 0"/>
+    <parent link="base_link"/><child link="imu_link"/><origin xyz="-0.05 0 0.09"/>
   </joint>
   <link name="imu_link"/>
   <joint name="scan_joint" type="fixed">
-    <parent link="base_link"/><child link="base_scan"/><origin xyz="-0.032 0 0.172" rpy="0 0 0"/>
+    <parent link="base_link"/><child link="base_scan"/><origin xyz="0 0 0.2"/>
   </joint>
   <link name="base_scan">
-    <collision><origin xyz="0.015 0 -0.0065" rpy="0 0 0"/>
-      <geometry><cylinder length="0.0315" radius="0.055"/></geometry></collision>
-    <inertial><mass value="0.114"/><inertia ixx="0.001" iyy="0.001" izz="0.001"/></inertial>
+    <collision><geometry><cylinder length="0.04" radius="0.04"/></geometry></collision>
+    <inertial><mass value="0.2"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"/></inertial>
   </link>
 )";
 
-const char kBurgerGazebo[] = R"(
-  <gazebo reference="base_link"><material>Gazebo/DarkGrey</material></gazebo>
-  <gazebo reference="wheel_left_link"><mu1>0.1</mu1><mu2>0.1</mu2><kp>500000.0</kp></gazebo>
+const char kRoverGazebo[] = R"(
+  <gazebo reference="base_link"><material>Gazebo/Orange</material></gazebo>
+  <gazebo reference="wheel_left_link"><mu1>0.9</mu1><mu2>0.9</mu2><kp>1e6</kp></gazebo>
   <gazebo reference="imu_link">
-    <sensor type="imu" name="imu"><always_on>true</always_on><visualize>false</visualize></sensor>
-    <material>Gazebo/FlatBlack</material>
+    <sensor type="imu" name="bare_imu"><always_on>true</always_on></sensor>
   </gazebo>
   <gazebo>
-    <plugin name="turtlebot3_burger_controller" filename="libgazebo_ros_diff_drive.so">
+    <plugin name="rover_drive" filename="libgazebo_ros_diff_drive.so">
       <commandTopic>cmd_vel</commandTopic><odometryTopic>odom</odometryTopic>
       <odometryFrame>odom</odometryFrame><robotBaseFrame>base_footprint</robotBaseFrame>
       <publishWheelTF>false</publishWheelTF><publishTf>true</publishTf>
       <publishWheelJointState>true</publishWheelJointState>
-      <legacyMode>false</legacyMode><updateRate>30</updateRate>
+      <legacyMode>false</legacyMode><updateRate>50</updateRate>
       <leftJoint>wheel_left_joint</leftJoint><rightJoint>wheel_right_joint</rightJoint>
-      <wheelSeparation>0.160</wheelSeparation><wheelDiameter>0.066</wheelDiameter>
-      <wheelAcceleration>1</wheelAcceleration><wheelTorque>10</wheelTorque>
+      <wheelSeparation>0.24</wheelSeparation><wheelDiameter>0.1</wheelDiameter>
+      <wheelAcceleration>2</wheelAcceleration><wheelTorque>5</wheelTorque>
       <rosDebugLevel>na</rosDebugLevel>
     </plugin>
   </gazebo>
@@ -117,28 +107,28 @@ const char kBurgerGazebo[] = R"(
     <plugin name="imu_plugin" filename="libgazebo_ros_imu.so">
       <alwaysOn>true</alwaysOn><bodyName>imu_link</bodyName><topicName>imu</topicName>
       <serviceName>imu_service</serviceName><gaussianNoise>0.0</gaussianNoise>
-      <updateRate>200</updateRate>
+      <updateRate>100</updateRate>
       <imu><noise><type>gaussian</type>
-        <rate><mean>0.0</mean><stddev>2e-4</stddev><bias_mean>0.0000075</bias_mean>
-          <bias_stddev>0.0000008</bias_stddev></rate>
-        <accel><mean>0.0</mean><stddev>1.7e-2</stddev><bias_mean>0.1</bias_mean>
-          <bias_stddev>0.001</bias_stddev></accel>
+        <rate><mean>0.0</mean><stddev>3e-4</stddev><bias_mean>1e-5</bias_mean>
+          <bias_stddev>1e-6</bias_stddev></rate>
+        <accel><mean>0.0</mean><stddev>2e-2</stddev><bias_mean>0.05</bias_mean>
+          <bias_stddev>0.002</bias_stddev></accel>
       </noise></imu>
     </plugin>
   </gazebo>
   <gazebo reference="base_scan">
-    <material>Gazebo/FlatBlack</material>
-    <sensor type="ray" name="lds_lfcd_sensor">
-      <pose>0 0 0 0 0 0</pose><visualize>false</visualize><update_rate>5</update_rate>
+    <material>Gazebo/Black</material>
+    <sensor type="ray" name="lidar">
+      <pose>0 0 0 0 0 0</pose><visualize>false</visualize><update_rate>10</update_rate>
       <ray>
-        <scan><horizontal><samples>360</samples><resolution>1</resolution>
-          <min_angle>0.0</min_angle><max_angle>6.28319</max_angle></horizontal></scan>
-        <range><min>0.120</min><max>3.5</max><resolution>0.015</resolution></range>
-        <noise><type>gaussian</type><mean>0.0</mean><stddev>0.01</stddev></noise>
+        <scan><horizontal><samples>720</samples><resolution>1</resolution>
+          <min_angle>-3.14159</min_angle><max_angle>3.14159</max_angle></horizontal></scan>
+        <range><min>0.15</min><max>6.0</max><resolution>0.01</resolution></range>
+        <noise><type>gaussian</type><mean>0.0</mean><stddev>0.02</stddev></noise>
       </ray>
-      <plugin name="gazebo_ros_lds_lfcd_controller" filename="libgazebo_ros_laser.so">
+      <plugin name="lidar_controller" filename="libgazebo_ros_laser.so">
         <topicName>scan</topicName><frameName>base_scan</frameName>
-        <update_rate>1800</update_rate>
+        <update_rate>1000</update_rate>
       </plugin>
     </sensor>
   </gazebo>
@@ -169,34 +159,34 @@ std::string Laser(const std::string& ray, const std::string& sensor_extra = "") 
 
 const char kRange[] = "<range><min>0.1</min><max>10</max></range>";
 
-TEST(GazeboPluginsTest, TurtleBot3BurgerReadsEveryField) {
+TEST(GazeboPluginsTest, AMobileRobotDescriptionReadsEveryField) {
   const Result<LoadedModel> model = LoadArticulated(
-      std::string("<robot name='turtlebot3_burger'>") + kBurgerLinks + kBurgerGazebo + "</robot>");
+      std::string("<robot name='small_rover'>") + kRoverLinks + kRoverGazebo + "</robot>");
   ASSERT_TRUE(model.ok()) << model.message();
   const GazeboPlugins& plugins = model->plugins;
   ASSERT_EQ(plugins.lasers.size(), 1u);
   const LaserSensor& laser = plugins.lasers[0];
-  EXPECT_EQ(laser.common.name, "lds_lfcd_sensor");
+  EXPECT_EQ(laser.common.name, "lidar");
   EXPECT_EQ(laser.common.filename, "libgazebo_ros_laser.so");
   // base_scan is merged into base_footprint's body by fixed joints and
   // keeps its name; the node finds it in `links`.
   EXPECT_EQ(laser.common.link, "base_scan");
   EXPECT_TRUE(laser.common.link_from_sensor.translation.isZero());
   EXPECT_TRUE(laser.common.link_from_sensor.rotation.isApprox(physics::Quat::Identity()));
-  EXPECT_DOUBLE_EQ(laser.common.update_rate, 5.0);  // the plugin's 1800 is not read
+  EXPECT_DOUBLE_EQ(laser.common.update_rate, 10.0);  // the plugin's 1000 is not read
   EXPECT_EQ(laser.common.robot_namespace, "");
   EXPECT_EQ(laser.common.topic, "scan");
   EXPECT_EQ(laser.common.frame_id, "base_scan");
-  EXPECT_EQ(laser.horizontal_samples, 360);
+  EXPECT_EQ(laser.horizontal_samples, 720);
   EXPECT_DOUBLE_EQ(laser.horizontal_resolution, 1.0);
-  EXPECT_DOUBLE_EQ(laser.min_angle, 0.0);
-  EXPECT_DOUBLE_EQ(laser.max_angle, 6.28319);
+  EXPECT_DOUBLE_EQ(laser.min_angle, -3.14159);
+  EXPECT_DOUBLE_EQ(laser.max_angle, 3.14159);
   EXPECT_EQ(laser.vertical_samples, 1);
-  EXPECT_DOUBLE_EQ(laser.range_min, 0.12);
-  EXPECT_DOUBLE_EQ(laser.range_max, 3.5);
-  EXPECT_DOUBLE_EQ(laser.range_resolution, 0.015);
+  EXPECT_DOUBLE_EQ(laser.range_min, 0.15);
+  EXPECT_DOUBLE_EQ(laser.range_max, 6.0);
+  EXPECT_DOUBLE_EQ(laser.range_resolution, 0.01);
   EXPECT_DOUBLE_EQ(laser.noise.mean, 0.0);
-  EXPECT_DOUBLE_EQ(laser.noise.stddev, 0.01);
+  EXPECT_DOUBLE_EQ(laser.noise.stddev, 0.02);
   EXPECT_DOUBLE_EQ(laser.noise.bias_stddev, 0.0);
   EXPECT_FALSE(laser.point_cloud);
   ASSERT_EQ(plugins.imus.size(), 1u);
@@ -206,24 +196,24 @@ TEST(GazeboPluginsTest, TurtleBot3BurgerReadsEveryField) {
   EXPECT_EQ(imu.common.link, "imu_link");
   EXPECT_EQ(imu.common.topic, "imu");
   EXPECT_EQ(imu.common.frame_id, "imu_link");
-  EXPECT_DOUBLE_EQ(imu.common.update_rate, 200.0);
+  EXPECT_DOUBLE_EQ(imu.common.update_rate, 100.0);
   // gazebo_ros_imu reads only <gaussianNoise> (0); its <imu><noise> is not.
   EXPECT_TRUE(imu.orientation.IsZero());
   EXPECT_TRUE(imu.angular_velocity.IsZero());
   EXPECT_TRUE(imu.linear_acceleration.IsZero());
   ASSERT_EQ(plugins.diff_drives.size(), 1u);
   const DiffDrive& drive = plugins.diff_drives[0];
-  EXPECT_EQ(drive.common.name, "turtlebot3_burger_controller");
+  EXPECT_EQ(drive.common.name, "rover_drive");
   EXPECT_EQ(drive.common.filename, "libgazebo_ros_diff_drive.so");
   EXPECT_EQ(drive.common.link, "base_footprint");
   EXPECT_EQ(drive.common.topic, "cmd_vel");
-  EXPECT_DOUBLE_EQ(drive.common.update_rate, 30.0);
+  EXPECT_DOUBLE_EQ(drive.common.update_rate, 50.0);
   EXPECT_EQ(drive.left_joint, "wheel_left_joint");
   EXPECT_EQ(drive.right_joint, "wheel_right_joint");
-  EXPECT_DOUBLE_EQ(drive.wheel_separation, 0.16);
-  EXPECT_DOUBLE_EQ(drive.wheel_diameter, 0.066);
-  EXPECT_DOUBLE_EQ(drive.wheel_torque, 10.0);
-  EXPECT_DOUBLE_EQ(drive.wheel_acceleration, 1.0);
+  EXPECT_DOUBLE_EQ(drive.wheel_separation, 0.24);
+  EXPECT_DOUBLE_EQ(drive.wheel_diameter, 0.1);
+  EXPECT_DOUBLE_EQ(drive.wheel_torque, 5.0);
+  EXPECT_DOUBLE_EQ(drive.wheel_acceleration, 2.0);
   EXPECT_EQ(drive.odometry_topic, "odom");
   EXPECT_EQ(drive.odometry_frame, "odom");
   EXPECT_EQ(drive.robot_base_frame, "base_footprint");
@@ -238,7 +228,7 @@ TEST(GazeboPluginsTest, TurtleBot3BurgerReadsEveryField) {
   EXPECT_TRUE(plugins.odometry.empty());
   // The <sensor type="imu"> has no plugin: Gazebo publishes nothing for it.
   EXPECT_EQ(plugins.ignored,
-            (std::vector<std::string>{"<gazebo reference='imu_link'> sensor 'imu' (imu)"}));
+            (std::vector<std::string>{"<gazebo reference='imu_link'> sensor 'bare_imu' (imu)"}));
   EXPECT_EQ(model->ignored, plugins.ignored);
 }
 
