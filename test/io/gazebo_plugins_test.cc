@@ -160,8 +160,8 @@ std::string Laser(const std::string& ray, const std::string& sensor_extra = "") 
 const char kRange[] = "<range><min>0.1</min><max>10</max></range>";
 
 TEST(GazeboPluginsTest, AMobileRobotDescriptionReadsEveryField) {
-  const Result<LoadedModel> model = LoadArticulated(
-      std::string("<robot name='small_rover'>") + kRoverLinks + kRoverGazebo + "</robot>");
+  const Result<LoadedModel> model = LoadArticulated(std::string("<robot name='small_rover'>") +
+                                                    kRoverLinks + kRoverGazebo + "</robot>");
   ASSERT_TRUE(model.ok()) << model.message();
   const GazeboPlugins& plugins = model->plugins;
   ASSERT_EQ(plugins.lasers.size(), 1u);
