@@ -121,6 +121,13 @@ std::string FrameName(const std::string& model, const std::string& link) {
   return model + names::kFrameSeparator + link;
 }
 
+int LinkIndex(const Model& model, const std::string& link_name) {
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    if (model.links[i].link_name == link_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
 std::string TfFrame(const Model& model, const std::string& link) { return model.tf_prefix + link; }
 
 namespace {

@@ -99,7 +99,9 @@ struct RunningDiffDrive {
   SensorClock clock;
   WheelSpeeds wheels;  // rim speeds commanded last step, m/s
   PlanarOdometry encoder;
-  double left_before = 0.0;  // rad, wheel positions before the step
+  // rad, the wheels' positions before the step (DriveWheelsLocked reads
+  // them then, so a reset or ~set_joint_state between steps is no turn).
+  double left_before = 0.0;
   double right_before = 0.0;
   // The odom -> base tf replaces the node's world -> root: the base is the
   // root link and publish_tf is set.

@@ -30,12 +30,11 @@ ros::Time SimNode::StampLocked() const {
 
 namespace {
 
-std::size_t LinkIndex(const Model& model, const std::string& link_name) {
-  for (std::size_t i = 0; i < model.links.size(); ++i) {
-    if (model.links[i].link_name == link_name) return i;
-  }
-  assert(false && "a joint names a link of its model");
-  return 0;
+// A joint's link: every joint names links of its model.
+std::size_t JointLink(const Model& model, const std::string& link_name) {
+  const int index = LinkIndex(model, link_name);
+  assert(index >= 0 && "a joint names a link of its model");
+  return static_cast<std::size_t>(index);
 }
 
 }  // namespace
@@ -75,9 +74,9 @@ void SimNode::AppendModelTfLocked(const Model& model, const ros::Time& stamp,
   for (const io::JointInfo& joint : model.joints) {
     if (joint.type == "fixed") continue;
     const physics::Pose world_from_parent =
-        LinkStateLocked(model, LinkIndex(model, joint.parent_link)).world_from_frame;
+        LinkStateLocked(model, JointLink(model, joint.parent_link)).world_from_frame;
     const physics::Pose world_from_child =
-        LinkStateLocked(model, LinkIndex(model, joint.child_link)).world_from_frame;
+        LinkStateLocked(model, JointLink(model, joint.child_link)).world_from_frame;
     tf->transforms.push_back(TransformToMsg(world_from_parent.Inverse() * world_from_child,
                                             TfFrame(model, joint.parent_link),
                                             TfFrame(model, joint.child_link), stamp));
@@ -100,9 +99,9 @@ tf2_msgs::TFMessage SimNode::StaticTfLocked() const {
     for (const io::JointInfo& joint : model.joints) {
       if (joint.type != "fixed") continue;
       const physics::Pose& root_from_parent =
-          model.links[LinkIndex(model, joint.parent_link)].root_from_link;
+          model.links[JointLink(model, joint.parent_link)].root_from_link;
       const physics::Pose& root_from_child =
-          model.links[LinkIndex(model, joint.child_link)].root_from_link;
+          model.links[JointLink(model, joint.child_link)].root_from_link;
       tf.transforms.push_back(TransformToMsg(root_from_parent.Inverse() * root_from_child,
                                              TfFrame(model, joint.parent_link),
                                              TfFrame(model, joint.child_link), stamp));

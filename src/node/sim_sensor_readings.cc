@@ -265,8 +265,6 @@ void SimNode::ReadDriveOdometryLocked(const Model& model, const ros::Time& stamp
   const std::vector<physics::JointState> joints = world_.GetJointStates(model.articulation);
   IntegrateWheels(drive->spec, joints[drive->left].position - drive->left_before,
                   joints[drive->right].position - drive->right_before, dt, &drive->encoder);
-  drive->left_before = joints[drive->left].position;
-  drive->right_before = joints[drive->right].position;
   if (!drive->spec.publish_odometry || !drive->clock.Due(world_.time())) return;
   nav_msgs::Odometry message = OdometryToMsg(DriveOdometryLocked(model, *drive));
   if (!drive->spec.odometry_from_encoders) {

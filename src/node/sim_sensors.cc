@@ -43,13 +43,6 @@ bool SensorClock::Due(double now) {
 
 namespace {
 
-int FindLink(const Model& model, const std::string& name) {
-  for (std::size_t i = 0; i < model.links.size(); ++i) {
-    if (model.links[i].link_name == name) return static_cast<int>(i);
-  }
-  return -1;
-}
-
 // The link and every link below it, through fixed and movable joints.
 std::vector<int> SubtreeLinks(const Model& model, const std::string& top) {
   std::vector<std::string> names{top};
@@ -59,14 +52,14 @@ std::vector<int> SubtreeLinks(const Model& model, const std::string& top) {
     }
   }
   std::vector<int> links;
-  for (const std::string& name : names) links.push_back(FindLink(model, name));
+  for (const std::string& name : names) links.push_back(LinkIndex(model, name));
   return links;
 }
 
 // A frame a plugin names: a link of the model is its tf frame; any other
 // name (odom, map) is taken as written.
 std::string SensorFrame(const Model& model, const std::string& frame) {
-  return FindLink(model, frame) >= 0 ? TfFrame(model, frame) : frame;
+  return LinkIndex(model, frame) >= 0 ? TfFrame(model, frame) : frame;
 }
 
 SensorClock StartClock(double rate) {
@@ -107,7 +100,7 @@ Status SimNode::AddLasersLocked(const Model& model, const io::GazeboPlugins& plu
   for (const io::LaserSensor& spec : plugins.lasers) {
     RunningLaser laser;
     laser.spec = spec;
-    laser.link = FindLink(model, spec.common.link);
+    laser.link = LinkIndex(model, spec.common.link);
     if (laser.link < 0) return UnknownLink(spec.common);
     laser.directions_sensor = LaserDirections(spec);
     laser.frame_id = SensorFrame(model, spec.common.frame_id);
@@ -125,7 +118,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
   for (const io::ImuSensor& spec : plugins.imus) {
     RunningImu imu;
     imu.spec = spec;
-    imu.link = FindLink(model, spec.common.link);
+    imu.link = LinkIndex(model, spec.common.link);
     if (imu.link < 0) return UnknownLink(spec.common);
     imu.frame_id = SensorFrame(model, spec.common.frame_id);
     imu.publisher = AdvertiseSensor<sensor_msgs::Imu>(model, spec.common);
@@ -139,7 +132,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
   for (const io::BumperSensor& spec : plugins.bumpers) {
     RunningBumper bumper;
     bumper.spec = spec;
-    if (FindLink(model, spec.common.link) < 0) return UnknownLink(spec.common);
+    if (LinkIndex(model, spec.common.link) < 0) return UnknownLink(spec.common);
     bumper.link_frame = FrameName(model.name, spec.common.link);
     bumper.frame_id = SensorFrame(model, spec.common.frame_id);
     bumper.publisher = AdvertiseSensor<rigid_body_sim::Contacts>(model, spec.common);
@@ -149,7 +142,7 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
   for (const io::ForceTorqueSensor& spec : plugins.force_torque) {
     RunningForceTorque sensor;
     sensor.spec = spec;
-    sensor.child = FindLink(model, spec.common.link);
+    sensor.child = LinkIndex(model, spec.common.link);
     if (sensor.child < 0) return UnknownLink(spec.common);
     sensor.subtree = SubtreeLinks(model, spec.common.link);
     for (const int link : sensor.subtree) {
@@ -164,9 +157,9 @@ Status SimNode::AddInertialSensorsLocked(const Model& model, const io::GazeboPlu
   for (const io::GroundTruthOdometry& spec : plugins.odometry) {
     RunningOdometry odometry;
     odometry.spec = spec;
-    odometry.link = FindLink(model, spec.common.link);
+    odometry.link = LinkIndex(model, spec.common.link);
     if (odometry.link < 0) return UnknownLink(spec.common);
-    odometry.reference = spec.reference_link.empty() ? -1 : FindLink(model, spec.reference_link);
+    odometry.reference = spec.reference_link.empty() ? -1 : LinkIndex(model, spec.reference_link);
     odometry.frame_id =
         odometry.reference >= 0 ? TfFrame(model, spec.reference_link) : options_.world_frame;
     odometry.child_frame_id = TfFrame(model, spec.common.link);
@@ -194,14 +187,11 @@ Status SimNode::AddDrivesLocked(const Model& model, const io::GazeboPlugins& plu
                            spec.left_joint + "' and '" + spec.right_joint +
                            "', which must be movable joints of an articulated model");
     }
-    const int base = FindLink(model, spec.robot_base_frame);
+    const int base = LinkIndex(model, spec.robot_base_frame);
     drive.base = base >= 0 ? base : 0;
     drive.owns_root_tf = spec.publish_odometry && spec.publish_tf && drive.base == 0;
     drive.odom_frame = model.tf_prefix + spec.odometry_frame;
     drive.base_frame = TfFrame(model, model.links[drive.base].link_name);
-    const std::vector<physics::JointState> joints = world_.GetJointStates(model.articulation);
-    drive.left_before = joints[drive.left].position;
-    drive.right_before = joints[drive.right].position;
     drive.command = std::make_shared<DriveCommand>();
     ros::NodeHandle handle = SensorHandle(model, spec.common);
     const std::shared_ptr<DriveCommand> command = drive.command;

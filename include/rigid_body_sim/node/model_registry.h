@@ -133,6 +133,9 @@ struct Model {
 // The tf frame of a link of `model`: its tf prefix and the link's name.
 std::string TfFrame(const Model& model, const std::string& link);
 
+// The index of the link named `link_name` in model.links, or -1.
+int LinkIndex(const Model& model, const std::string& link_name);
+
 // A frame of a model: the model and one of its links.
 struct FrameRef {
   const Model* model = nullptr;
