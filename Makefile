@@ -15,8 +15,15 @@ WS := $(ROOT)/build/.ws
 CORE_BUILD := $(ROOT)/build/sanitize
 JOBS ?= 2
 CMAKE_ARGS ?=
+# Line tables only (-g1): stack traces, sanitizer reports and perf keep
+# their file:line, and the builds take about a third less time than with
+# full debug information (the core: 2.4 min instead of 3.4 min on 2 cores).
+# `make test DEBUG_INFO=-g` brings back gdb's locals.
+DEBUG_INFO := -g1
+RELWITHDEBINFO := -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 $(DEBUG_INFO) -DNDEBUG"
 CATKIN := catkin_make -C $(WS) -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_ARGS)
+  $(RELWITHDEBINFO) $(CMAKE_ARGS)
 
 .PHONY: demo test deps build test-sanitize sanitize test-tsan fuzz bench clean format soak
 
@@ -75,7 +82,7 @@ build: deps ws-links
 # -Werror build is `make test`'s.
 test-sanitize: deps
 	cmake -S $(ROOT) -B $(CORE_BUILD) -DRBS_CORE_ONLY=ON -DRBS_WERROR=ON -DCMAKE_BUILD_TYPE=None \
-	  -DCMAKE_CXX_FLAGS="-O2 -g -DEIGEN_NO_DEBUG -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -Wno-maybe-uninitialized" \
+	  -DCMAKE_CXX_FLAGS="-O2 $(DEBUG_INFO) -DEIGEN_NO_DEBUG -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -Wno-maybe-uninitialized" \
 	  > /dev/null
 	cmake --build $(CORE_BUILD) -j$(JOBS)
 	cd $(CORE_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
@@ -86,7 +93,7 @@ test-sanitize: deps
 WS_TSAN := $(ROOT)/build/.ws-tsan
 test-tsan: deps
 	$(MAKE) --no-print-directory ws-links WS=$(WS_TSAN)
-	catkin_make -C $(WS_TSAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	catkin_make -C $(WS_TSAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 $(RELWITHDEBINFO) \
 	  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
 	  -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread $(CMAKE_ARGS) \
 	  rigid_body_sim_node node_concurrency_test -j$(JOBS) 2>&1 \
@@ -119,7 +126,7 @@ SANITIZE_TARGETS := rigid_body_sim_node rigid_body_sim_mesh_helper rigid_body_si
 sanitize: deps
 	$(MAKE) --no-print-directory ws-links WS=$(WS_ASAN)
 	catkin_make -C $(WS_ASAN) -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=None \
-	  -DCMAKE_CXX_FLAGS="-O2 -g $(SANITIZE_FLAGS) -DEIGEN_NO_DEBUG -Wno-maybe-uninitialized" \
+	  -DCMAKE_CXX_FLAGS="-O2 $(DEBUG_INFO) $(SANITIZE_FLAGS) -DEIGEN_NO_DEBUG -Wno-maybe-uninitialized" \
 	  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) \
 	  $(SANITIZE_TARGETS) -j$(JOBS) 2>&1 \
 	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|[Ee]rror|warning|undefined' || true)
@@ -146,7 +153,7 @@ FUZZERS := urdf_loader_fuzzer mesh_parser_fuzzer request_validation_fuzzer joint
 fuzz: deps
 	cmake -S $(ROOT) -B $(FUZZ_BUILD) -DRBS_CORE_ONLY=ON -DRBS_FUZZ=ON -DCMAKE_BUILD_TYPE=None \
 	  -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \
-	  -DCMAKE_CXX_FLAGS="-O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" \
+	  -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" \
 	  > /dev/null
 	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target $(FUZZERS) rigid_body_sim_mesh_helper
 	@mkdir -p $(FUZZ_BUILD)/artifacts
