@@ -21,6 +21,8 @@
 
 namespace rigid_body_sim::physics {
 
+class WideBoxTree;
+
 class CollisionMesh {
  public:
   // Most triangles a mesh may have (16 Mi): its tree and adjacency then take
@@ -42,16 +44,6 @@ class CollisionMesh {
     std::array<EdgeFold, 3> edge_folds{};
   };
 
-  // A node of the tree: a box and either two children (count == 0; the left
-  // child is the next node, the right child is node `first`) or a leaf of
-  // `count` triangles from `first` on.
-  struct Node {
-    Vec3 lower = Vec3::Zero();  // m, mesh frame
-    Vec3 upper = Vec3::Zero();
-    int first = 0;
-    int count = 0;
-  };
-
   // Welds vertices at equal positions, drops triangles of zero area, winds
   // each connected component consistently, finds each edge's neighbour and
   // builds the tree. Fails with a message for a
@@ -62,10 +54,12 @@ class CollisionMesh {
   const std::vector<Vec3>& vertices() const { return vertices_; }
   // In tree order (leaves hold consecutive triangles), not the input order.
   const std::vector<Triangle>& triangles() const { return triangles_; }
-  const std::vector<Node>& nodes() const { return nodes_; }
+  // The tree of the triangles' boxes (physics/geometry/wide_box_tree.h):
+  // leaf items are triangle indices.
+  const WideBoxTree& tree() const { return *tree_; }
 
-  const Vec3& lower() const { return nodes_.front().lower; }
-  const Vec3& upper() const { return nodes_.front().upper; }
+  const Vec3& lower() const { return lower_; }
+  const Vec3& upper() const { return upper_; }
   // The largest distance of a vertex from `center` (m).
   double BoundingRadius(const Vec3& center) const;
 
@@ -83,7 +77,9 @@ class CollisionMesh {
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
-  std::vector<Node> nodes_;
+  std::shared_ptr<const WideBoxTree> tree_;
+  Vec3 lower_ = Vec3::Zero();  // m, mesh frame: the box of every vertex
+  Vec3 upper_ = Vec3::Zero();
 };
 
 }  // namespace rigid_body_sim::physics

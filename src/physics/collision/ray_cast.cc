@@ -5,6 +5,8 @@
 #include <cmath>
 #include <variant>
 
+#include "physics/geometry/wide_box_tree.h"
+
 namespace rigid_body_sim::physics {
 namespace {
 
@@ -181,50 +183,20 @@ RayHit RayCastHalfSpace(const Ray& ray) {
   return MakeHit(ray, t, Vec3::UnitZ());
 }
 
-// The tree walked nearest child first, a node skipped when its box begins
-// beyond the nearest hit so far (each box is tested once, when its parent
-// is opened).
+// The mesh's tree walked nearest child first, a leaf skipped when it
+// begins beyond the nearest hit so far; the triangles in double precision.
 RayHit RayCastMesh(const CollisionMesh& mesh, const Ray& ray) {
-  const std::vector<CollisionMesh::Node>& nodes = mesh.nodes();
-  const Vec3 inverse = SlabInverse(ray.direction);
   double best = ray.max_distance;
   int best_triangle = -1;
-  struct Pending {
-    int node;
-    double entry;
-  };
-  std::array<Pending, 64> stack;
-  int size = 0;
-  const SlabInterval root = RaySlabs(ray.origin, inverse, nodes[0].lower, nodes[0].upper, best);
-  if (root.entry <= root.exit) stack[size++] = {0, root.entry};
-  while (size > 0) {
-    const Pending pending = stack[--size];
-    if (pending.entry > best) continue;
-    const CollisionMesh::Node& node = nodes[pending.node];
-    if (node.count > 0) {
-      for (int i = node.first; i < node.first + node.count; ++i) {
-        const double t = RayMeshTriangle(mesh, i, ray);
-        if (Nearer(t, i, best, best_triangle)) {
-          best = t;
-          best_triangle = i;
-        }
+  mesh.tree().CastRay(ray.origin, ray.direction, &best, [&](int first, int count) {
+    for (int i = first; i < first + count; ++i) {
+      const double t = RayMeshTriangle(mesh, i, ray);
+      if (Nearer(t, i, best, best_triangle)) {
+        best = t;
+        best_triangle = i;
       }
-      continue;
     }
-    if (size + 2 > static_cast<int>(stack.size())) return RayCastMeshBruteForce(mesh, ray);
-    const int left = pending.node + 1;
-    const int right = node.first;
-    const SlabInterval a =
-        RaySlabs(ray.origin, inverse, nodes[left].lower, nodes[left].upper, best);
-    const SlabInterval b =
-        RaySlabs(ray.origin, inverse, nodes[right].lower, nodes[right].upper, best);
-    // The nearer child is taken first (pushed last).
-    const bool left_first = a.entry <= b.entry;
-    const SlabInterval& near = left_first ? a : b;
-    const SlabInterval& far = left_first ? b : a;
-    if (far.entry <= far.exit) stack[size++] = {left_first ? right : left, far.entry};
-    if (near.entry <= near.exit) stack[size++] = {left_first ? left : right, near.entry};
-  }
+  });
   return MeshHit(mesh, ray, best, best_triangle);
 }
 
