@@ -180,6 +180,12 @@ BENCH_RUNS ?= 3
 # Comma-separated scene names to run only those (physics_bench --only).
 BENCH_ONLY ?=
 bench: deps
+	@# MuJoCo is the benchmark's alone (physics_bench's articulated scenes): not
+	@# in install_deps.sh, so that make test and CI do not install it.
+	@dpkg -s libmujoco-dev 2> /dev/null | grep -q '^Status: install ok installed' || \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends libmujoco-dev || \
+	  { apt-get update -q && DEBIAN_FRONTEND=noninteractive \
+	    apt-get install -y -q --no-install-recommends libmujoco-dev; }
 	cmake -S $(ROOT) -B $(BENCH_BUILD) -DRBS_CORE_ONLY=ON -DRBS_BENCH=ON -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" > /dev/null
 	cmake --build $(BENCH_BUILD) -j$(JOBS) \

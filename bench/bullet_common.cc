@@ -107,6 +107,14 @@ double BulletBodies::KineticEnergy() const {
   return energy;
 }
 
+double BulletBodies::MechanicalEnergy() const {
+  double energy = KineticEnergy();
+  for (const std::unique_ptr<btRigidBody>& body : bodies_) {
+    energy += kGravity / body->getInvMass() * body->getCenterOfMassPosition().z();
+  }
+  return energy;
+}
+
 double BulletMaxPenetration(btCollisionDispatcher* dispatcher) {
   double depth = 0.0;
   for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {

@@ -101,6 +101,8 @@ class BulletBodies {
   bool AllAwake() const;
   // T = 1/2 m v^2 + 1/2 sum_i I_i (R^T omega)_i^2 over the free bodies.
   double KineticEnergy() const;
+  // That plus m g z of each free body's centre of mass (J).
+  double MechanicalEnergy() const;
 
  private:
   btCollisionShape* Shape(const BenchBody& body);

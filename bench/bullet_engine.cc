@@ -37,6 +37,7 @@ class BulletEngine : public Engine {
  public:
   BulletEngine(const Scene& scene, const BulletSleep& sleep)
       : name_(sleep.like_ours ? "bullet_oursleep" : "bullet"),
+        time_step_(scene.time_step),
         dispatcher_(&configuration_),
         world_(&dispatcher_, &broad_phase_, &solver_, &configuration_) {
     ApplyBulletSleep(sleep);
@@ -48,7 +49,7 @@ class BulletEngine : public Engine {
 
   void Step() override {
     world_.ResetTimes();
-    world_.stepSimulation(kTimeStep, 0);
+    world_.stepSimulation(static_cast<btScalar>(time_step_), 0);
   }
 
   StageTimes LastStageTimes() const override {
@@ -65,6 +66,7 @@ class BulletEngine : public Engine {
     return FromBullet(bodies_->bodies()[index]->getLinearVelocity());
   }
   double KineticEnergy() const override { return bodies_->KineticEnergy(); }
+  double MechanicalEnergy() const override { return bodies_->MechanicalEnergy(); }
   double MaxPenetration() const override { return BulletMaxPenetration(&dispatcher_); }
 
   // A normal row and one friction row: the default solver mode leaves out
@@ -79,6 +81,7 @@ class BulletEngine : public Engine {
 
  private:
   std::string name_;
+  double time_step_;  // s
   btDefaultCollisionConfiguration configuration_;
   // Bullet reads manifolds through non-const accessors only.
   mutable btCollisionDispatcher dispatcher_;
@@ -104,6 +107,10 @@ std::string EngineName(EngineKind kind) {
       return "bullet";
     case EngineKind::kBulletOurSleep:
       return "bullet_oursleep";
+    case EngineKind::kMujocoRk4:
+      return "mujoco_rk4";
+    case EngineKind::kMujocoEuler:
+      return "mujoco_euler";
   }
   return "";
 }
@@ -117,6 +124,9 @@ std::unique_ptr<Engine> MakeEngine(EngineKind kind, const Scene& scene,
     OurSettingsOverrides two = overrides;
     two.threads = 2;
     return MakeOurEngine(scene, two);
+  }
+  if (kind == EngineKind::kMujocoRk4 || kind == EngineKind::kMujocoEuler) {
+    return MakeMujocoEngine(scene, kind == EngineKind::kMujocoRk4);
   }
   BulletSleep sleep;
   if (kind == EngineKind::kBulletOurSleep) {

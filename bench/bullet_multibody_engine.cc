@@ -47,6 +47,7 @@ class BulletMultiBodyEngine : public Engine {
  public:
   BulletMultiBodyEngine(const Scene& scene, const BulletSleep& sleep)
       : name_(sleep.like_ours ? "bullet_oursleep" : "bullet"),
+        time_step_(scene.time_step),
         dispatcher_(&configuration_),
         world_(&dispatcher_, &broad_phase_, &solver_, &configuration_) {
     ApplyBulletSleep(sleep);
@@ -67,7 +68,7 @@ class BulletMultiBodyEngine : public Engine {
 
   void Step() override {
     world_.ResetTimes();
-    world_.stepSimulation(kTimeStep, 0);
+    world_.stepSimulation(static_cast<btScalar>(time_step_), 0);
   }
 
   StageTimes LastStageTimes() const override {
@@ -84,6 +85,7 @@ class BulletMultiBodyEngine : public Engine {
     return FromBullet(bodies_->bodies()[index]->getLinearVelocity());
   }
   double KineticEnergy() const override { return bodies_->KineticEnergy(); }
+  double MechanicalEnergy() const override;
   double MaxPenetration() const override { return BulletMaxPenetration(&dispatcher_); }
   int RowsPerPoint() const override { return 2; }
 
@@ -110,6 +112,7 @@ class BulletMultiBodyEngine : public Engine {
   void AddColliders(const BenchArticulation& articulation, btMultiBody* body);
 
   std::string name_;
+  double time_step_;  // s
   btDefaultCollisionConfiguration configuration_;
   mutable btCollisionDispatcher dispatcher_;
   btDbvtBroadphase broad_phase_;
@@ -121,7 +124,9 @@ class BulletMultiBodyEngine : public Engine {
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders_;
   std::vector<std::unique_ptr<btMultiBodyJointMotor>> motors_;
   std::vector<BulletJoint> joints_;
-  // Forward kinematics' scratch space.
+  // Forward kinematics' and link velocities' scratch space.
+  mutable std::vector<btVector3> link_omega_;
+  mutable std::vector<btVector3> link_velocity_;
   mutable btAlignedObjectArray<btQuaternion> world_to_local_;
   mutable btAlignedObjectArray<btVector3> local_origin_;
 };
@@ -167,7 +172,7 @@ void BulletMultiBodyEngine::AddArticulation(const BenchArticulation& articulatio
   const std::size_t first_joint = joints_.size() - static_cast<std::size_t>(link_count);
   for (int j = 0; j < link_count; ++j) {
     if (articulation.motors.empty() || articulation.motors[j].empty()) continue;
-    const double max_impulse = articulation.joints[j].effort_limit * kTimeStep;  // N m s
+    const double max_impulse = articulation.joints[j].effort_limit * time_step_;  // N m s
     motors_.push_back(std::make_unique<btMultiBodyJointMotor>(
         body.get(), j, static_cast<btScalar>(articulation.motors[j].front().velocity),
         static_cast<btScalar>(max_impulse)));
@@ -211,6 +216,28 @@ double BulletMultiBodyEngine::JointAnchorSeparation() const {
     separation = std::max(separation, static_cast<double>(gap.length()));
   }
   return separation;
+}
+
+// Each link's velocity in its centre-of-mass frame (compTreeLinkVelocities:
+// entry 0 is the base, which is fixed) and the height of its centre of mass
+// (forwardKinematics).
+double BulletMultiBodyEngine::MechanicalEnergy() const {
+  double energy = bodies_->MechanicalEnergy();
+  for (const std::unique_ptr<btMultiBody>& body : multi_bodies_) {
+    body->forwardKinematics(world_to_local_, local_origin_);
+    const int links = body->getNumLinks();
+    link_omega_.resize(static_cast<std::size_t>(links) + 1);
+    link_velocity_.resize(static_cast<std::size_t>(links) + 1);
+    body->compTreeLinkVelocities(link_omega_.data(), link_velocity_.data());
+    for (int i = 0; i < links; ++i) {
+      const btScalar mass = body->getLinkMass(i);
+      const btVector3& omega = link_omega_[static_cast<std::size_t>(i) + 1];
+      energy += 0.5 * mass * link_velocity_[static_cast<std::size_t>(i) + 1].length2() +
+                0.5 * (body->getLinkInertia(i) * omega).dot(omega) +
+                mass * kGravity * body->getLink(i).m_cachedWorldTransform.getOrigin().z();
+    }
+  }
+  return energy;
 }
 
 }  // namespace

@@ -29,7 +29,7 @@ class Engine {
  public:
   virtual ~Engine() = default;
   virtual std::string name() const = 0;
-  // Advances by the engine's one step of 1/240 s.
+  // Advances by one step of the scene's time_step.
   virtual void Step() = 0;
   // Stage times of the last Step.
   virtual StageTimes LastStageTimes() const = 0;
@@ -38,6 +38,10 @@ class Engine {
   virtual Vec3 LinearVelocity(int index) const = 0;
   // J, summed over the dynamic bodies.
   virtual double KineticEnergy() const = 0;
+  // J: kinetic energy plus m g z of the centre of mass, summed over every
+  // body that can move (free bodies and every link but a fixed base); what
+  // an articulated row's energy drift is measured on.
+  virtual double MechanicalEnergy() const = 0;
   // m, the deepest penetration among the current contact points.
   virtual double MaxPenetration() const = 0;
   // Contact rows one contact point adds to a velocity iteration: with the
@@ -59,8 +63,6 @@ class Engine {
   virtual void SetMotorVelocity(int joint, double velocity) = 0;
 };
 
-constexpr double kTimeStep = 1.0 / 240.0;  // s, both engines
-
 // Settings of our engine that a benchmark run may set to other values than
 // the defaults, to measure what they cost and what they buy; unset keeps
 // the default (physics::WorldSettings).
@@ -76,11 +78,19 @@ struct OurSettingsOverrides {
 
 // The engines under test: ours on one thread; Bullet with its defaults;
 // Bullet with the sleep thresholds of ours (bullet_engine.cc); ours on two
-// threads. Bullet's multi-threaded world is left out: Debian's build has no
-// thread-safe Bullet (performance.md).
-enum class EngineKind { kOurs, kBullet, kBulletOurSleep, kOursTwoThreads };
-// "ours", "bullet" or "bullet_oursleep"; both of ours are "ours", told apart
-// by EngineThreads.
+// threads; in the articulated scenes also MuJoCo with its RK4 and with its
+// Euler integrator (mujoco_engine.cc). Bullet's multi-threaded world is left
+// out: Debian's build has no thread-safe Bullet (performance.md).
+enum class EngineKind {
+  kOurs,
+  kBullet,
+  kBulletOurSleep,
+  kOursTwoThreads,
+  kMujocoRk4,
+  kMujocoEuler
+};
+// "ours", "bullet", "bullet_oursleep", "mujoco_rk4" or "mujoco_euler"; both
+// of ours are "ours", told apart by EngineThreads.
 std::string EngineName(EngineKind kind);
 int EngineThreads(EngineKind kind);
 
@@ -98,6 +108,8 @@ std::unique_ptr<Engine> MakeOurEngine(const Scene& scene,
 std::unique_ptr<Engine> MakeBulletEngine(const Scene& scene, const BulletSleep& sleep);
 // btMultiBodyDynamicsWorld (Featherstone's btMultiBody) for articulated scenes.
 std::unique_ptr<Engine> MakeBulletMultiBodyEngine(const Scene& scene, const BulletSleep& sleep);
+// MuJoCo for articulated scenes, integrating with RK4 or with Euler.
+std::unique_ptr<Engine> MakeMujocoEngine(const Scene& scene, bool rk4);
 // The engine of `kind`; Bullet's sleep thresholds of ours follow `overrides`.
 std::unique_ptr<Engine> MakeEngine(EngineKind kind, const Scene& scene,
                                    const OurSettingsOverrides& overrides);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <random>
 #include <utility>
@@ -18,15 +19,18 @@ namespace rigid_body_sim::bench {
 namespace {
 
 // The velocity motors of a scene's articulations, joints numbered over all
-// of them (Engine), and the driven joint's commanded angle.
+// of them (Engine), the angle each one's commands add up to, and the
+// driven joint's commanded angle.
 class MotorSchedule {
  public:
-  explicit MotorSchedule(const Scene& scene) : driven_(scene.driven_joint) {
+  MotorSchedule(const Scene& scene, const Engine& engine)
+      : driven_(scene.driven_joint), time_step_(scene.time_step) {
     int joint = 0;
     for (const BenchArticulation& articulation : scene.articulations) {
       for (std::size_t j = 0; j < articulation.joints.size(); ++j, ++joint) {
         if (j < articulation.motors.size() && !articulation.motors[j].empty()) {
-          motors_.push_back(Motor{joint, articulation.motors[j], 0.0, false});
+          motors_.push_back(
+              Motor{joint, articulation.motors[j], 0.0, false, engine.JointPosition(joint), 0.0});
         }
       }
     }
@@ -42,8 +46,20 @@ class MotorSchedule {
       if (!motor.set || velocity != motor.velocity) engine->SetMotorVelocity(motor.joint, velocity);
       motor.velocity = velocity;
       motor.set = true;
-      if (motor.joint == driven_) commanded_ += velocity * kTimeStep;
+      motor.commanded += velocity * time_step_;
+      if (motor.joint == driven_) commanded_ += velocity * time_step_;
     }
+  }
+
+  // rad: the largest distance of a motored joint from its start plus its
+  // commands so far.
+  double ServoError(const Engine& engine) const {
+    double error = 0.0;
+    for (const Motor& motor : motors_) {
+      const double at = engine.JointPosition(motor.joint);
+      error = std::max(error, std::abs(at - motor.start - motor.commanded));
+    }
+    return error;
   }
 
   double commanded() const { return commanded_; }  // rad, the driven joint's so far
@@ -54,10 +70,46 @@ class MotorSchedule {
     std::vector<MotorPhase> phases;
     double velocity;
     bool set;
+    double start;      // rad
+    double commanded;  // rad, the commands' sum so far
   };
   int driven_;
+  double time_step_;  // s
   std::vector<Motor> motors_;
   double commanded_ = 0.0;
+};
+
+// The mechanical energy of an articulated run against its start, as
+// fractions of the scene's EnergyScale.
+class EnergyTracker {
+ public:
+  EnergyTracker(const Scene& scene, const Engine& engine)
+      : scale_(std::max(EnergyScale(scene), 1e-9)), start_(engine.MechanicalEnergy()) {}
+
+  void Observe(const Engine& engine) {
+    const double energy = engine.MechanicalEnergy();
+    if (!std::isfinite(energy)) {
+      finite_ = false;
+      return;
+    }
+    last_ = energy;
+    growth_ = std::max(growth_, (energy - start_) / scale_);
+  }
+
+  void Finish(RunResult* result) const {
+    constexpr double kInfinity = std::numeric_limits<double>::infinity();
+    result->energy_start = start_;
+    result->energy_drift = finite_ ? (last_ - start_) / scale_ : kInfinity;
+    result->energy_growth = finite_ ? growth_ : kInfinity;
+    result->diverged = !finite_ || !std::isfinite(start_) || growth_ > kDivergedGrowth;
+  }
+
+ private:
+  double scale_;  // J
+  double start_;  // J
+  double last_ = start_;
+  double growth_ = 0.0;
+  bool finite_ = true;
 };
 
 // The first apex of a bounce: the highest point between leaving the ground
@@ -135,19 +187,21 @@ void FinishRun(const Scene& scene, const Engine& engine, RunResult* result) {
 RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& settings) {
   std::unique_ptr<Engine> engine = MakeEngine(kind, scene, settings.overrides);
   RunResult result;
-  result.steps = static_cast<int>(std::lround(scene.seconds / kTimeStep));
+  const double dt = scene.time_step;
+  result.steps = static_cast<int>(std::lround(scene.seconds / dt));
   result.rows_per_point = engine->RowsPerPoint();
   const int window_steps =
-      std::min(result.steps, static_cast<int>(std::lround(settings.window_seconds / kTimeStep)));
+      std::min(result.steps, static_cast<int>(std::lround(settings.window_seconds / dt)));
   const bool articulated = !scene.articulations.empty();
-  MotorSchedule motors(scene);
+  MotorSchedule motors(scene, *engine);
+  EnergyTracker energy(scene, *engine);
   ApexTracker apex;
   const double driven_start =
       scene.driven_joint >= 0 ? engine->JointPosition(scene.driven_joint) : 0.0;
   double total_ms = 0.0;
   using Clock = std::chrono::steady_clock;
   for (int step = 0; step < result.steps; ++step) {
-    motors.Apply(step * kTimeStep, engine.get());
+    motors.Apply(step * dt, engine.get());
     const Clock::time_point start = Clock::now();
     engine->Step();
     const double step_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -161,6 +215,8 @@ RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& setti
     result.peak_penetration = std::max(result.peak_penetration, engine->MaxPenetration());
     if (articulated) {
       result.joint_separation = std::max(result.joint_separation, engine->JointAnchorSeparation());
+      energy.Observe(*engine);
+      result.servo_error = std::max(result.servo_error, motors.ServoError(*engine));
     }
     if (scene.driven_joint >= 0) {
       result.driven_swept =
@@ -173,7 +229,7 @@ RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& setti
     if (scene.kind == SceneKind::kTerrain) {
       for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i) {
         if (engine->LinearVelocity(i).norm() > 0.05) {
-          result.settle_time = (step + 1) * kTimeStep;
+          result.settle_time = (step + 1) * dt;
           break;
         }
       }
@@ -181,6 +237,7 @@ RunResult RunScene(const Scene& scene, EngineKind kind, const RunSettings& setti
   }
   result.step_ms = total_ms;
   FinishRun(scene, *engine, &result);
+  if (articulated) energy.Finish(&result);
   if (scene.kind == SceneKind::kBounce) {
     result.apex = apex.found ? apex.highest - scene.bodies[0].sphere_radius : 0.0;
   }
@@ -257,7 +314,9 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
     summary.bodies += static_cast<int>(articulation.links.size()) - 1;  // the moving links
   }
   summary.seconds = scene.seconds;
+  summary.time_step = scene.time_step;
   if (results.empty()) return summary;
+  for (const RunResult& result : results) summary.diverged_runs += result.diverged;
   // Each quality figure is the median over the runs on its own, so that it
   // does not depend on which run the machine happened to run fastest; the
   // times and the stage profile are those of the median run by time.
@@ -272,7 +331,11 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
                                                     &RunResult::driven_swept,
                                                     &RunResult::driven_commanded,
                                                     &RunResult::settle_time,
-                                                    &RunResult::below_surface};
+                                                    &RunResult::below_surface,
+                                                    &RunResult::energy_drift,
+                                                    &RunResult::energy_growth,
+                                                    &RunResult::energy_start,
+                                                    &RunResult::servo_error};
   std::vector<double> medians;
   for (double RunResult::*figure : kQualityFigures) {
     std::vector<double> values;
@@ -341,6 +404,9 @@ std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSetti
                      EngineName(engines[e]).c_str(), run);
       }
     }
+    // A run that diverged is no ratio's denominator, nor its numerator:
+    // an engine that blew up measured the time of another computation.
+    for (std::size_t e = 0; e < count; ++e) ok[e] = ok[e] && !this_run[e].diverged;
     // Ours is engines[0]: its ratio to each other engine in this run.
     for (std::size_t e = 1; e < count && ok[0]; ++e) {
       if (ok[e]) AddRatios(this_run[0], this_run[e], &ratios[e], &awake_ratios[e]);

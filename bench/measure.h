@@ -11,8 +11,6 @@
 
 namespace rigid_body_sim::bench {
 
-constexpr double kGravity = 9.81;  // m/s^2
-
 // What one run measures; plain data, sent from the child through a pipe.
 struct RunResult {
   bool ok = false;
@@ -50,9 +48,25 @@ struct RunResult {
   // Terrain: s until no body moved faster than 0.05 m/s (the sleep
   // threshold) any more, and the bodies whose centre ended below the surface.
   double settle_time = 0.0;
-  double below_surface = 0.0;  // rad, arm: the same of its commanded velocity
-  long peak_rss_kb = 0;        // filled in by the parent
+  double below_surface = 0.0;
+  // Articulated scenes, from Engine::MechanicalEnergy after every step:
+  // the change from the start at the end and the largest growth over the
+  // run, each as a fraction of the scene's EnergyScale (+inf when the
+  // energy turned non-finite), and whether the run diverged (kDivergedGrowth).
+  double energy_drift = 0.0;
+  double energy_growth = 0.0;
+  double energy_start = 0.0;  // J
+  bool diverged = false;
+  // rad, scenes with motors: the largest distance over the run of a motored
+  // joint from where its commanded velocities would have taken it.
+  double servo_error = 0.0;
+  long peak_rss_kb = 0;  // filled in by the parent
 };
+
+// A run diverged when its mechanical energy grew by more than this fraction
+// of the scene's energy scale at any step, or turned non-finite; its time
+// is then no engine's ratio's denominator (MeasureEngines).
+constexpr double kDivergedGrowth = 0.10;
 
 // wall ms per step of the steps with every moving body awake; 0 when none.
 inline double AwakeStepMs(const RunResult& result) {
@@ -70,6 +84,8 @@ struct Summary {
   int threads = 1;
   int bodies = 0;
   double seconds = 0.0;
+  double time_step = kDefaultTimeStep;  // s
+  int diverged_runs = 0;
   RunResult median;  // the median run by time, with each quality figure's median
   double ms_median = 0.0;
   double ms_min = 0.0;
@@ -80,7 +96,8 @@ struct Summary {
   long peak_rss_kb = 0;  // largest over the runs
   // Other engines than ours: the medians over the runs of ours / this
   // engine, ms per step and ms per awake step, each pair of runs made back
-  // to back (MeasureEngines); 0 when not measured.
+  // to back (MeasureEngines); 0 when not measured. Runs that diverged, this
+  // engine's or ours, give no ratio.
   double ours_over_this = 0.0;
   double ours_over_this_awake = 0.0;
   // The same for ours on two threads over this engine, when it ran.

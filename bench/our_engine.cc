@@ -92,7 +92,7 @@ class OurEngine : public Engine {
  public:
   OurEngine(const Scene& scene, const OurSettingsOverrides& overrides) {
     physics::WorldSettings settings;
-    settings.time_step = kTimeStep;
+    settings.time_step = scene.time_step;
     physics::SolverSettings& solver = settings.solver;
     solver.velocity_iterations = overrides.velocity_iterations.value_or(solver.velocity_iterations);
     solver.velocity_tolerance = overrides.velocity_tolerance.value_or(solver.velocity_tolerance);
@@ -177,6 +177,17 @@ class OurEngine : public Engine {
       const physics::Body& body = world_->GetBody(id);
       energy += 0.5 * body.linear_velocity.dot(body.linear_momentum) +
                 0.5 * body.angular_velocity.dot(body.angular_momentum);
+    }
+    return energy;
+  }
+
+  double MechanicalEnergy() const override {
+    double energy = 0.0;
+    for (const physics::BodyId id : moving_) {
+      const physics::Body& body = world_->GetBody(id);
+      energy += 0.5 * body.linear_velocity.dot(body.linear_momentum) +
+                0.5 * body.angular_velocity.dot(body.angular_momentum) +
+                body.mass * kGravity * body.position.z();
     }
     return energy;
   }

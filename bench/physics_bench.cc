@@ -17,6 +17,7 @@
 //                      [--velocity-iterations N] [--time-to-sleep S]
 //                      [--velocity-tolerance V] [--interleave-independent-runs 0|1]
 //                      [--batch-independent-runs 0|1] [--hill-amplitude A]
+//                      [--articulated-rates 240,1000]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
 //   their number of runs. --velocity-iterations, --time-to-sleep (s),
@@ -26,7 +27,17 @@
 //   measure what a setting costs or buys; the header says so
 //   (--time-to-sleep also reaches bullet_oursleep). --hill-amplitude A (m,
 //   [0, 2], default 0.5) sets the height of terrain_100's hills, to measure
-//   how the time to rest grows with their slope.
+//   how the time to rest grows with their slope. --articulated-rates lists
+//   the step rates (Hz, default 240 and 1000) at which each articulated
+//   scene runs; the free-body scenes always step at 240 Hz. A row at another
+//   rate than 240 Hz has "_<rate>hz" after its scene's name.
+//
+// The articulated scenes (chain_30, arm_push_100, panda_like, panda_held,
+// ur5_like) also run in MuJoCo with its RK4 and with its Euler integrator,
+// and each of their rows gives the engine's energy drift, or the servo
+// error of its motors, beside its time; a run whose energy grew by more
+// than 10 % of the scene's scale or turned non-finite is marked diverged
+// and gives no ratio (measure.h).
 
 #include <algorithm>
 #include <cmath>
@@ -57,7 +68,8 @@ struct Options {
   double scale = 1.0;
   std::vector<std::string> only;
   std::string hull_bench;
-  double hill_amplitude = 0.5;  // m, terrain_100's hills
+  double hill_amplitude = 0.5;                       // m, terrain_100's hills
+  std::vector<int> articulated_rates = {240, 1000};  // Hz
   OurSettingsOverrides overrides;
   std::string error;  // set when an option's value is refused
 };
@@ -93,6 +105,18 @@ Options ParseOptions(int argc, char** argv) {
       std::stringstream list(value);
       std::string name;
       while (std::getline(list, name, ',')) options.only.push_back(name);
+    } else if (key == "--articulated-rates") {
+      options.articulated_rates.clear();
+      std::stringstream list(value);
+      std::string rate;
+      while (std::getline(list, rate, ',')) {
+        const std::optional<double> hz = ParseNumber(rate);
+        if (!hz || *hz < 1.0 || *hz > 100000.0 || *hz != std::floor(*hz)) {
+          options.error = "--articulated-rates wants whole step rates in Hz, got " + value;
+        } else {
+          options.articulated_rates.push_back(static_cast<int>(*hz));
+        }
+      }
     } else if (key == "--hull-bench") {
       options.hull_bench = value;
     } else if (key == "--velocity-iterations") {
@@ -155,11 +179,15 @@ std::vector<Scene> SelectScenes(const Options& options) {
       MakeIncline(25.0),
       MakeIncline(28.0),
       MakeIncline(35.0),
-      MakeChain(30, 10.0),
-      MakeArmPush(100, 10.0),
       MakeTerrain(100, 100000, 10.0, options.hill_amplitude),
       MakeFlatTerrain(100, 10.0),
   };
+  const std::vector<Scene> articulated = {MakeChain(30, 10.0), MakeArmPush(100, 10.0),
+                                          MakePandaLike(false, 5.0), MakePandaLike(true, 5.0),
+                                          MakeUr5Like(5.0)};
+  for (const Scene& scene : articulated) {
+    for (const int hz : options.articulated_rates) scenes.push_back(AtStepRate(scene, hz));
+  }
   if (!options.only.empty()) {
     scenes.erase(std::remove_if(scenes.begin(), scenes.end(),
                                 [&](const Scene& scene) {
@@ -203,20 +231,25 @@ void PrintHeader(const Options& options, double window_seconds) {
     std::printf("terrain_100: hills of %g m instead of 0.5 m\n", options.hill_amplitude);
   }
   std::printf(
-      "dt = 1/240 s, one step per output frame; wall ms per step: median of %d runs "
+      "dt = 1/240 s (articulated rows at another rate: 1/rate, named _<rate>hz), one step per "
+      "output frame; wall ms per step: median of %d runs "
       "[min, max], each run in its own process, run k of each engine right after another; "
       "awake ms: ms per step over the steps with every moving body awake (median over the "
       "runs); ours/it, awake: ours over that engine, ms per step and ms per awake step, the "
       "median of the runs' ratios; bullet_oursleep: Bullet with our sleep thresholds and time; "
       "ours x2: ours on two threads (its ours/it: ours on one thread over it); "
-      "chain and arm: Bullet's btMultiBody\n",
+      "articulated scenes: Bullet's btMultiBody, and MuJoCo with RK4 and with Euler\n",
       options.runs);
   std::printf(
       "quality figures (KE, pen, drift, apex, slide): each the median over the runs (run 0 as "
       "defined, run k > 0 with every body moved by up to 1 um, seed k, the same for both "
       "engines); drift: pile = horizontal distance of the top box from its column, pyramid = "
       "distance of the top box from its start; pen = deepest contact at the end [peak over "
-      "the run]\n\n");
+      "the run]; articulated rows: energy drift = (E_end - E_0) / scale [largest growth "
+      "(E - E_0) / scale over the run], E = kinetic + m g z over the moving bodies, scale = sum "
+      "m g |c - base| at the start; servo = largest distance of a motored joint from its "
+      "commanded angle; DIVERGED: the energy grew by more than 10 %% of the scale or turned "
+      "non-finite (in that many runs); such runs give no ratio\n\n");
   PrintTableHeader();
 }
 
@@ -226,11 +259,15 @@ Rows MeasureScenes(const Options& options, const std::vector<Scene>& scenes,
   const std::vector<EngineKind> engines = {EngineKind::kOurs, EngineKind::kBullet,
                                            EngineKind::kBulletOurSleep,
                                            EngineKind::kOursTwoThreads};
+  std::vector<EngineKind> articulated_engines = engines;
+  articulated_engines.push_back(EngineKind::kMujocoRk4);
+  articulated_engines.push_back(EngineKind::kMujocoEuler);
   Rows rows;
   for (const Scene& scene : scenes) {
     const int runs = IsLarge(scene) ? options.large_runs : options.runs;
     const RunSettings run_settings{window_seconds, options.overrides};
-    rows.push_back(MeasureEngines(scene, runs, run_settings, engines));
+    rows.push_back(MeasureEngines(scene, runs, run_settings,
+                                  scene.articulations.empty() ? engines : articulated_engines));
     PrintSceneRows(scene, rows.back());
   }
   return rows;

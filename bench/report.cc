@@ -69,12 +69,44 @@ Quality SceneQuality(const Scene& scene, const RunResult& result) {
       std::snprintf(text, sizeof(text), "all at rest after %.2f s, %.0f below the surface",
                     result.settle_time, result.below_surface);
       break;
+    case SceneKind::kLimpArm:
+      quality.value = result.energy_drift;
+      std::snprintf(text, sizeof(text), "joint sep. %.2g m", result.joint_separation);
+      break;
+    case SceneKind::kHeldArm:
+      quality.value = result.servo_error;
+      std::snprintf(text, sizeof(text), "joint sep. %.2g m", result.joint_separation);
+      break;
     default:
       quality.value = result.drift;
       std::snprintf(text, sizeof(text), "top-box drift %.4f m", result.drift);
   }
   quality.text = text;
   return quality;
+}
+
+// An articulated row's energy drift and growth (as percentages of the
+// scene's energy scale), its servo error where it has motors, and the mark
+// of runs that diverged; empty for the other scenes.
+std::string ArticulatedFigures(const Scene& scene, const Summary& summary) {
+  if (scene.articulations.empty()) return "";
+  const RunResult& result = summary.median;
+  char text[160];
+  std::snprintf(text, sizeof(text), "; E drift %+.3g %% [growth %.3g %%]",
+                100.0 * result.energy_drift, 100.0 * result.energy_growth);
+  std::string figures = text;
+  bool motors = false;
+  for (const BenchArticulation& articulation : scene.articulations) {
+    for (const std::vector<MotorPhase>& motor : articulation.motors) motors |= !motor.empty();
+  }
+  if (motors) {
+    std::snprintf(text, sizeof(text), "; servo %.3g rad", result.servo_error);
+    figures += text;
+  }
+  if (summary.diverged_runs > 0) {
+    figures += "; DIVERGED (" + std::to_string(summary.diverged_runs) + " runs)";
+  }
+  return figures;
 }
 
 std::string Number(double value) {
@@ -135,7 +167,8 @@ void PrintSceneRows(const Scene& scene, const std::vector<Summary>& summaries) {
         summary.ms_median, summary.ms_min, summary.ms_max, summary.awake_ms_median,
         Ratio(summary.ours_over_this).c_str(), Ratio(summary.ours_over_this_awake).c_str(),
         summary.median.final_kinetic_energy, 1e3 * summary.median.final_penetration,
-        1e3 * summary.median.peak_penetration, summary.peak_rss_kb / 1024.0, quality.text.c_str());
+        1e3 * summary.median.peak_penetration, summary.peak_rss_kb / 1024.0,
+        (quality.text + ArticulatedFigures(scene, summary)).c_str());
   }
   std::fflush(stdout);
 }
@@ -159,8 +192,8 @@ void PrintStageProfile(const Rows& rows) {
       std::printf("%-12s %-15s %9.3f %9.3f %9.3f %9.3f %13.1f %10.2f %16.3f %8.2f\n",
                   summary.scene.c_str(), EngineLabel(summary).c_str(), result.broad_phase_ms,
                   result.narrow_phase_ms, result.solver_ms, result.integrator_ms, RowCostNs(result),
-                  result.contact_steps * kTimeStep, ContactStepMs(result),
-                  result.awake_steps * kTimeStep);
+                  result.contact_steps * summary.time_step, ContactStepMs(result),
+                  result.awake_steps * summary.time_step);
     }
   }
 }
@@ -203,8 +236,9 @@ void PrintScaling(const Rows& rows, double window_seconds) {
     const double large_ms = per_step(large);
     std::printf(" %s %.3f -> %.3f ms, x%.2f (%.2f -> %.2f s with contacts);",
                 (*pile_1000)[e].engine.c_str(), small_ms, large_ms,
-                small_ms > 0.0 ? large_ms / small_ms : 0.0, small.window_contact_steps * kTimeStep,
-                large.window_contact_steps * kTimeStep);
+                small_ms > 0.0 ? large_ms / small_ms : 0.0,
+                small.window_contact_steps * kDefaultTimeStep,
+                large.window_contact_steps * kDefaultTimeStep);
   }
   std::printf("\n");
 }
@@ -221,7 +255,8 @@ const std::vector<std::string>& CsvColumns() {
       "incline_slide_m", "incline_error", "joint_separation_m", "boxes_moved",
       "driven_joint_swept_rad", "driven_joint_commanded_rad", "broad_phase_ms", "narrow_phase_ms",
       "solver_ms", "integrator_ms", "solver_ns_per_row_iteration", "peak_rss_kb", "contact_seconds",
-      "ms_per_contact_step"};
+      "ms_per_contact_step", "time_step_s", "energy_drift", "energy_growth", "energy_start_j",
+      "servo_error_rad", "diverged_runs"};
   return kColumns;
 }
 
@@ -247,7 +282,8 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
           {"ms_per_step_min", Number(summary.ms_min)},
           {"ms_per_step_max", Number(summary.ms_max)},
           {"steps_per_second", Number(1e3 / summary.ms_median)},
-          {"awake_seconds", Number(result.awake_steps * kTimeStep)},
+          {"awake_seconds", Number(result.awake_steps * summary.time_step)},
+          {"time_step_s", Number(summary.time_step)},
           {"final_kinetic_energy_j", Number(result.final_kinetic_energy)},
           {"final_penetration_m", Number(result.final_penetration)},
           {"broad_phase_ms", Number(result.broad_phase_ms)},
@@ -256,7 +292,7 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
           {"integrator_ms", Number(result.integrator_ms)},
           {"solver_ns_per_row_iteration", Number(RowCostNs(result))},
           {"peak_rss_kb", std::to_string(summary.peak_rss_kb)},
-          {"contact_seconds", Number(result.contact_steps * kTimeStep)},
+          {"contact_seconds", Number(result.contact_steps * summary.time_step)},
           {"ms_per_contact_step", Number(ContactStepMs(result))}};
       if (summary.awake_ms_median > 0.0) {
         values["ms_per_awake_step_median"] = Number(summary.awake_ms_median);
@@ -273,6 +309,13 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
       if (summary.ours2_over_this_awake > 0.0) {
         values["ours2_over_this_ms_per_awake_step"] = Number(summary.ours2_over_this_awake);
       }
+      if (!scene.articulations.empty()) {
+        values["energy_drift"] = Number(result.energy_drift);
+        values["energy_growth"] = Number(result.energy_growth);
+        values["energy_start_j"] = Number(result.energy_start);
+        values["servo_error_rad"] = Number(result.servo_error);
+        values["diverged_runs"] = std::to_string(summary.diverged_runs);
+      }
       const Quality quality = SceneQuality(scene, result);
       switch (scene.kind) {
         case SceneKind::kPile:
@@ -286,6 +329,10 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
         case SceneKind::kIncline:
           values["incline_slide_m"] = Number(result.slide);
           values["incline_error"] = Number(quality.value);
+          break;
+        case SceneKind::kLimpArm:
+        case SceneKind::kHeldArm:
+          values["joint_separation_m"] = Number(result.joint_separation);
           break;
         case SceneKind::kArmPush:
           values["boxes_moved"] = Number(result.boxes_moved);

@@ -239,6 +239,38 @@ Scene MakeArmPush(int boxes, double seconds) {
   return scene;
 }
 
+Scene AtStepRate(Scene scene, int hz) {
+  scene.time_step = 1.0 / hz;
+  if (hz != 240) scene.name += "_" + std::to_string(hz) + "hz";
+  return scene;
+}
+
+double EnergyScale(const Scene& scene) {
+  const Vec3 origin = scene.articulations.empty()
+                          ? Vec3::Zero()
+                          : scene.articulations[0].world_from_base.translation;
+  double scale = 0.0;
+  for (const BenchBody& body : scene.bodies) {
+    scale += body.mass * kGravity * (body.world_from_body.translation - origin).norm();
+  }
+  for (const BenchArticulation& articulation : scene.articulations) {
+    // Each link's frame at the start: its parent's moved by the joint's
+    // offset and turned by its angle (BenchJoint).
+    std::vector<Pose> world_from_link = {articulation.world_from_base};
+    for (const BenchJoint& joint : articulation.joints) {
+      Pose child = world_from_link[joint.parent];
+      child.translation = child * joint.parent_offset;
+      child.rotation = child.rotation * Quat(Eigen::AngleAxisd(joint.position, joint.axis));
+      world_from_link.push_back(child);
+    }
+    for (std::size_t i = 1; i < articulation.links.size(); ++i) {
+      const BenchLink& link = articulation.links[i];
+      scale += link.mass * kGravity * (world_from_link[i] * link.center_of_mass - origin).norm();
+    }
+  }
+  return scale;
+}
+
 double Hills::HeightAt(double x, double y) const {
   return amplitude * std::sin(x / wavelength) * std::cos(y / wavelength);
 }

@@ -15,6 +15,11 @@ using physics::Pose;
 using physics::Quat;
 using physics::Vec3;
 
+// s, the step of every scene unless it sets another (Scene::time_step).
+constexpr double kDefaultTimeStep = 1.0 / 240.0;
+// m/s^2, along -z in every engine.
+constexpr double kGravity = 9.81;
+
 // Material as our engine combines it: e = max(e_a, e_b),
 // mu = sqrt(mu_a mu_b). Engines with other rules convert (bullet_engine.cc).
 struct BenchMaterial {
@@ -41,6 +46,8 @@ enum class SceneKind {
   kChain,    // largest joint anchor separation over the run (it should be ~0)
   kArmPush,  // boxes the arm pushed, and how far its driven joint turned
   kTerrain,  // time until every body is at rest, and bodies whose centre ended below the surface
+  kLimpArm,  // energy drift of an arm swinging under gravity with no motors
+  kHeldArm,  // servo error of an arm whose velocity motors hold it still
 };
 
 // The hills of the terrain scenes: z = amplitude sin(x / wavelength)
@@ -99,10 +106,11 @@ struct Scene {
   Pose world_from_ground;
   BenchMaterial ground_material;
   std::vector<BenchBody> bodies;
-  double seconds = 10.0;       // s of simulated time
-  int top_body = -1;           // index of the body whose drift is reported
-  double drop_height = 0.0;    // m, bounce: fall of the sphere's lowest point
-  double slope_degrees = 0.0;  // incline: slope angle
+  double seconds = 10.0;                // s of simulated time
+  double time_step = kDefaultTimeStep;  // s, every engine's step
+  int top_body = -1;                    // index of the body whose drift is reported
+  double drop_height = 0.0;             // m, bounce: fall of the sphere's lowest point
+  double slope_degrees = 0.0;           // incline: slope angle
   // Articulated scenes: one articulation beside the free bodies.
   std::vector<BenchArticulation> articulations;
   int driven_joint = -1;  // arm: the joint whose swept angle is reported
@@ -133,6 +141,29 @@ Scene MakeChain(int links, double seconds);
 // yaw motor sweeps it through 100 boxes of 0.1 m on the ground and back
 // (scene.cc); shoulder and elbow motors hold them still.
 Scene MakeArmPush(int boxes, double seconds);
+
+// J: sum over the bodies that can move of m g |c - o|, c a body's centre
+// of mass at the start and o the base of the first articulation (the
+// world's origin without one): the most potential energy a body that stays
+// that far from o can trade, and the scale an articulated run's energy
+// drift is measured against (measure.h).
+double EnergyScale(const Scene& scene);
+
+// The scene stepped at `hz` steps per second instead of 240: its name
+// gains "_<hz>hz" (none at 240 Hz, so the rows of earlier runs keep theirs).
+Scene AtStepRate(Scene scene, int hz);
+
+// panda_like (limp) and panda_held: a fixed-base 7-DOF arm with the masses,
+// centres of mass and the diagonals of the inertias of Franka Emika's
+// published Panda model (arm_scenes.cc; no hand), started in the Panda's
+// "ready" pose. Limp: no motors, no damping, it swings under gravity; the
+// energy should stay constant. Held: each joint's velocity motor commands 0
+// with the Panda's torque limits (87 N m on joints 1-4, 12 N m on 5-7).
+Scene MakePandaLike(bool held, double seconds);
+// ur5_like: a fixed-base 6-DOF arm with Universal Robots' published UR5
+// link lengths (DH), masses and centres of mass, limp, released stretched
+// out horizontally.
+Scene MakeUr5Like(double seconds);
 
 // terrain_N: N unit boxes (1 kg, mu 0.5) dropped from 1 m above rolling
 // hills (amplitude 0.5 m unless given, wavelength 3 m) made of `triangles` (rounded up
