@@ -121,6 +121,7 @@ class BulletMultiBodyEngine : public Engine {
   int solver_iterations_ = world_.getSolverInfo().m_numIterations;
   std::unique_ptr<BulletBodies> bodies_;  // declared after world_: removed from it first
   std::vector<std::unique_ptr<btMultiBody>> multi_bodies_;
+  btSphereShape island_marker_{0.01f};  // motored links without a box (AddColliders)
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders_;
   std::vector<std::unique_ptr<btMultiBodyJointMotor>> motors_;
   std::vector<BulletJoint> joints_;
@@ -182,16 +183,26 @@ void BulletMultiBodyEngine::AddArticulation(const BenchArticulation& articulatio
   multi_bodies_.push_back(std::move(body));
 }
 
+// Bullet solves a multibody's joint motors only in the simulation island of
+// one of its colliders: a link with motors but no box gets a collider that
+// touches nothing (filter group and mask 0), or its motors would never act.
 void BulletMultiBodyEngine::AddColliders(const BenchArticulation& articulation, btMultiBody* body) {
+  bool motors = false;
+  for (const std::vector<MotorPhase>& motor : articulation.motors) motors |= !motor.empty();
   for (int j = 0; j < body->getNumLinks(); ++j) {
     const BenchLink& link = articulation.links[j + 1];
-    if (!link.has_box) continue;
+    if (!link.has_box && !motors) continue;
     auto collider = std::make_unique<btMultiBodyLinkCollider>(body, j);
-    collider->setCollisionShape(bodies_->Box(link.box_size));
-    collider->setFriction(static_cast<btScalar>(std::sqrt(link.material.friction)));
-    collider->setRestitution(static_cast<btScalar>(link.material.restitution));
-    world_.addCollisionObject(collider.get(), btBroadphaseProxy::DefaultFilter,
-                              btBroadphaseProxy::AllFilter);
+    if (link.has_box) {
+      collider->setCollisionShape(bodies_->Box(link.box_size));
+      collider->setFriction(static_cast<btScalar>(std::sqrt(link.material.friction)));
+      collider->setRestitution(static_cast<btScalar>(link.material.restitution));
+      world_.addCollisionObject(collider.get(), btBroadphaseProxy::DefaultFilter,
+                                btBroadphaseProxy::AllFilter);
+    } else {
+      collider->setCollisionShape(&island_marker_);
+      world_.addCollisionObject(collider.get(), 0, 0);
+    }
     body->getLink(j).m_collider = collider.get();
     colliders_.push_back(std::move(collider));
   }
