@@ -11,6 +11,13 @@ Bullet's best per awake step (the lower of bullet and bullet_oursleep), and
 ours on one thread over ours on two. Each ratio is the median of the runs'
 ratios that physics_bench measured, not a ratio of the medians. The fidelity
 scenes (bounce, incline) only with --all.
+
+The articulated scenes (those whose rows carry an energy drift) get a table
+of their own, one row per scene and step rate: each engine's ms per step
+beside its energy drift (or servo error, where motors hold or drive the
+arm), "diverged" where a run's energy grew by more than 10 % of the scene's
+scale or turned non-finite, and ours against the fastest other engine that
+did not diverge, named.
 """
 import csv
 import sys
@@ -34,6 +41,62 @@ def best_awake_ratio(rows, column):
     return f'{max(values):.2f}' if values else '–'
 
 
+ARTICULATED_ENGINES = [('ours', 'ours'), ('bullet', 'Bullet btMultiBody'),
+                       ('mujoco_rk4', 'MuJoCo RK4'), ('mujoco_euler', 'MuJoCo Euler')]
+
+
+def diverged(row):
+    return bool(row and row.get('diverged_runs') and int(row['diverged_runs']) > 0)
+
+
+def articulated_cell(row):
+    """ms per step, then the energy drift [largest growth] in % of the
+    scene's energy scale, or the servo error where the arm has motors."""
+    if not row:
+        return '–'
+    figures = (f"{100 * float(row['energy_drift']):+.2g} % "
+               f"[{100 * float(row['energy_growth']):.2g} %]")
+    if row.get('servo_error_rad') and float(row['servo_error_rad']) > 0:
+        figures += f", servo {float(row['servo_error_rad']):.2g} rad"
+    mark = ', **diverged**' if diverged(row) else ''
+    return f'{milliseconds(row)} ({figures}{mark})'
+
+
+def fastest_undiverged(engines):
+    """The other engine (not ours) that did not diverge with the lowest ms
+    per step: (its label, its row), or None."""
+    candidates = [(float(row['ms_per_step_median']), row['label'], row)
+                  for name, row in engines.items()
+                  if name != 'ours' and not name.startswith('ours_') and row
+                  and row.get('ms_per_step_median') and not diverged(row)]
+    if not candidates:
+        return None
+    _, label, row = min(candidates, key=lambda candidate: candidate[0])
+    return label, row
+
+
+def print_articulated(scenes):
+    print('| scene | dt s | ' + ' | '.join(f'{label} ms/step (energy drift [growth])'
+                                          for _, label in ARTICULATED_ENGINES) +
+          ' | fastest other engine not diverged | ours/it |')
+    print('|---|---|' + '---|' * len(ARTICULATED_ENGINES) + '---|---|')
+    for scene, engines in scenes.items():
+        ours = engines.get('ours')
+        if not ours or not ours.get('energy_drift'):
+            continue
+        best = fastest_undiverged(engines)
+        if best is None:
+            against, ratio_text = 'none', '–'
+        else:
+            against = best[0]
+            ratio_text = ('– (ours diverged)' if diverged(ours)
+                          else ratio(best[1], 'ours_over_this_ms_per_step'))
+        step = float(ours['time_step_s']) if ours.get('time_step_s') else 1 / 240
+        print(f'| {scene} | 1/{round(1 / step)} | ' +
+              ' | '.join(articulated_cell(engines.get(name)) for name, _ in ARTICULATED_ENGINES) +
+              f' | {against} | {ratio_text} |')
+
+
 def main():
     args = [arg for arg in sys.argv[1:] if not arg.startswith('--')]
     show_all = '--all' in sys.argv[1:]
@@ -44,7 +107,23 @@ def main():
             name = row['engine']
             if row.get('threads', '1') not in ('', '1'):
                 name += f"_x{row['threads']}"
+            if row['engine'] == 'bullet_oursleep':
+                name_label = 'Bullet btMultiBody, our sleep'
+            else:
+                name_label = dict(ARTICULATED_ENGINES).get(name, name)
+            row['label'] = name_label
             scenes.setdefault(row['scene'], {})[name] = row
+    free_body = [scene for scene, engines in scenes.items()
+                 if engines.get('ours') and not engines['ours'].get('energy_drift')]
+    if free_body:
+        print_free_body(scenes, show_all)
+    if len(free_body) < len(scenes):
+        if free_body:
+            print()
+        print_articulated(scenes)
+
+
+def print_free_body(scenes, show_all):
     print('| scene | bodies | sim s | ours ms/step | Bullet ms/step | ours/Bullet | '
           'ours/Bullet per awake step | ours/Bullet-oursleep | ours/Bullet-oursleep per awake '
           'step | ours x2 ms/step | ours x2/Bullet best per awake step | ours x1/ours x2 |')
@@ -52,7 +131,7 @@ def main():
     for scene, engines in scenes.items():
         ours = engines.get('ours')
         bullet = engines.get('bullet')
-        if not ours or not bullet:
+        if not ours or not bullet or ours.get('energy_drift'):
             continue
         if not show_all and scene.split('_')[0] in ('bounce', 'incline'):
             continue
