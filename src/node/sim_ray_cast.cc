@@ -1,7 +1,9 @@
 // ~ray_cast: rays in a frame of the request, cast against the world's
 // shapes (physics::World::CastRays), answered in the same frame.
+#include <cstdint>
 #include <limits>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -54,12 +56,21 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
     Result<std::vector<physics::RayHit>> cast = world_.CastRays(world_rays, ignore);
     if (!cast.ok()) return Fail(response, cast.message(), names::kRayCastService);
     hits = std::move(cast).value();
+    // Each shape's frame name is looked up once per request: most of a
+    // large batch hits a few shapes (a laser's room, a terrain).
+    std::unordered_map<std::uint64_t, std::string> frames;
     response.hit_frames.resize(hits.size());
     for (std::size_t i = 0; i < hits.size(); ++i) {
       if (!hits[i].hit) continue;
-      response.hit_frames[i] = ground_ && hits[i].body == *ground_
-                                   ? std::string(names::kGroundName)
-                                   : registry_.ShapeFrame(hits[i].body, hits[i].shape);
+      const std::uint64_t key =
+          std::uint64_t{hits[i].body.index} << 32 | static_cast<std::uint32_t>(hits[i].shape);
+      auto [frame, added] = frames.try_emplace(key);
+      if (added) {
+        frame->second = ground_ && hits[i].body == *ground_
+                            ? std::string(names::kGroundName)
+                            : registry_.ShapeFrame(hits[i].body, hits[i].shape);
+      }
+      response.hit_frames[i] = frame->second;
     }
   }
   const Pose frame_from_world = world_from_frame.Inverse();
