@@ -17,21 +17,14 @@ import io
 import math
 import os
 import random
-import signal
-import socket
-import subprocess
 import tempfile
 import time
+
+from node_session import NodeSession
 
 CELLS = 223  # terrain cells per side: 2 * 223^2 triangles
 SIZE = 100.0  # m
 BOXES = 1000
-
-
-def free_port():
-    with socket.socket() as probe:
-        probe.bind(('localhost', 0))
-        return probe.getsockname()[1]
 
 
 def write_terrain(path):
@@ -46,25 +39,6 @@ def write_terrain(path):
             for j in range(CELLS):
                 out.write('f %d %d %d\n' % (vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1)))
                 out.write('f %d %d %d\n' % (vertex(i, j), vertex(i + 1, j + 1), vertex(i, j + 1)))
-
-
-def start_node(port):
-    os.environ['ROS_MASTER_URI'] = f'http://localhost:{port}'
-    return subprocess.Popen(
-        ['roslaunch', '-p', str(port), 'rigid_body_sim', 'sim.launch', 'use_sim_time:=false'],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-
-
-def connect(rospy):
-    deadline = time.time() + 60.0
-    while True:
-        try:
-            rospy.init_node('ray_service_bench', anonymous=True, disable_signals=True)
-            return
-        except Exception:  # the master is not up yet
-            if time.time() > deadline:
-                raise
-            time.sleep(0.5)
 
 
 def spawn_scene(terrain_path):
@@ -114,11 +88,8 @@ def main():
     parser.add_argument('--rays', type=int, default=100000)
     parser.add_argument('--calls', type=int, default=5)
     args = parser.parse_args()
-    launch = start_node(free_port())
-    try:
-        import rospy
+    with NodeSession('ray_service_bench') as rospy:
         from rigid_body_sim.srv import RayCast, RayCastResponse
-        connect(rospy)
         with tempfile.TemporaryDirectory() as scratch:
             terrain_path = os.path.join(scratch, 'terrain.obj')
             write_terrain(terrain_path)
@@ -145,13 +116,6 @@ def main():
               f'{args.calls} round trips {1e3 * best:.1f} ms; this client encodes '
               f'{1e3 * encode:.1f} ms and decodes {1e3 * decode:.1f} ms; the node and the '
               f'transport {1e3 * (best - encode - decode):.1f} ms')
-    finally:
-        os.killpg(launch.pid, signal.SIGINT)
-        try:
-            launch.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            os.killpg(launch.pid, signal.SIGKILL)
-            launch.wait()
 
 
 if __name__ == '__main__':

@@ -12,21 +12,14 @@ it started.
 import argparse
 import csv
 import os
-import signal
-import socket
 import statistics
-import subprocess
 import sys
 import time
 
+from node_session import NodeSession
+
 URDF_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'urdf')
 MODELS = (('spawn_box', 'box.urdf'), ('spawn_mesh', 'mesh_object.urdf'))
-
-
-def free_port():
-    with socket.socket() as probe:
-        probe.bind(('localhost', 0))
-        return probe.getsockname()[1]
 
 
 def append_rows(csv_path, rows, calls):
@@ -47,25 +40,10 @@ def main():
     parser.add_argument('--csv', default='')
     args = parser.parse_args()
 
-    port = free_port()
-    os.environ['ROS_MASTER_URI'] = f'http://localhost:{port}'
-    launch = subprocess.Popen(
-        ['roslaunch', '-p', str(port), 'rigid_body_sim', 'sim.launch', 'use_sim_time:=false'],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-    try:
-        import rospy
+    with NodeSession('spawn_bench') as rospy:
         from geometry_msgs.msg import Pose, Twist
         from rigid_body_sim.srv import Spawn, SpawnRequest
 
-        deadline = time.time() + 60.0
-        while True:
-            try:
-                rospy.init_node('spawn_bench', anonymous=True, disable_signals=True)
-                break
-            except Exception:  # the master is not up yet
-                if time.time() > deadline:
-                    raise
-                time.sleep(0.5)
         rospy.wait_for_service('/rigid_body_sim/spawn', timeout=60.0)
         spawn = rospy.ServiceProxy('/rigid_body_sim/spawn', Spawn, persistent=True)
         rows = []
@@ -99,13 +77,6 @@ def main():
             rows.append((scene, median, min(times), max(times)))
         if args.csv:
             append_rows(args.csv, rows, args.calls)
-    finally:
-        os.killpg(launch.pid, signal.SIGINT)
-        try:
-            launch.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            os.killpg(launch.pid, signal.SIGKILL)
-            launch.wait()
 
 
 if __name__ == '__main__':
