@@ -122,8 +122,9 @@ WideBoxTree::FloatRay WideBoxTree::PrepareRay(const Vec3& origin, const Vec3& di
   const double margin = kMarginFraction * scale + std::numeric_limits<float>::min();
   FloatRay ray;
   for (int axis = 0; axis < 3; ++axis) {
-    ray.shift_lower[axis] = static_cast<float>(-origin[axis] - margin);
-    ray.shift_upper[axis] = static_cast<float>(-origin[axis] + margin);
+    // Rounded outward too (and clamped, for an origin beyond float's range).
+    ray.shift_lower[axis] = RoundDown(-origin[axis] - margin);
+    ray.shift_upper[axis] = RoundUp(-origin[axis] + margin);
     const double d = direction[axis];
     const double inverse = 1.0 / (d != 0.0 ? d : std::copysign(1e-300, d));
     ray.inverse[axis] = static_cast<float>(std::clamp(inverse, -kLargestInverse, kLargestInverse));
