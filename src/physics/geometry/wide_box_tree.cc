@@ -18,6 +18,7 @@ constexpr double kMarginFraction = 0x1p-20;
 // a ray that slow along an axis crosses its planes beyond any reach a
 // caller can use (t > 1e30 * margin).
 constexpr double kLargestInverse = 1e30;
+constexpr double kLargestFloat = std::numeric_limits<float>::max();
 
 Aabb RangeBox(const std::vector<Aabb>& boxes, const std::vector<int>& order, int begin, int end) {
   Aabb box = boxes[order[begin]];
@@ -122,9 +123,12 @@ WideBoxTree::FloatRay WideBoxTree::PrepareRay(const Vec3& origin, const Vec3& di
   const double margin = kMarginFraction * scale + std::numeric_limits<float>::min();
   FloatRay ray;
   for (int axis = 0; axis < 3; ++axis) {
-    // Rounded outward too (and clamped, for an origin beyond float's range).
-    ray.shift_lower[axis] = RoundDown(-origin[axis] - margin);
-    ray.shift_upper[axis] = RoundUp(-origin[axis] + margin);
+    // Rounded to nearest, which the margin covers; clamped first, as a
+    // conversion beyond float's range is undefined.
+    ray.shift_lower[axis] =
+        static_cast<float>(std::clamp(-origin[axis] - margin, -kLargestFloat, kLargestFloat));
+    ray.shift_upper[axis] =
+        static_cast<float>(std::clamp(-origin[axis] + margin, -kLargestFloat, kLargestFloat));
     const double d = direction[axis];
     const double inverse = 1.0 / (d != 0.0 ? d : std::copysign(1e-300, d));
     ray.inverse[axis] = static_cast<float>(std::clamp(inverse, -kLargestInverse, kLargestInverse));

@@ -143,25 +143,32 @@ std::vector<std::uint32_t> CastOrder(const std::vector<Ray>& rays, const Aabb& b
   constexpr int kDigitBits = 10;
   constexpr std::uint32_t kDigits = 1u << kDigitBits;
   const Vec3 extent = (box.max - box.min).cwiseMax(Vec3::Constant(1e-9));
-  std::vector<std::uint32_t> keys(rays.size());
-  std::vector<std::uint32_t> order(rays.size());
+  // Each entry is its key above its ray's index, so that the passes read
+  // their input in order instead of gathering keys by index.
+  std::vector<std::uint64_t> entries(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const Vec3 unit =
         ((rays[i].origin - box.min).cwiseQuotient(extent)).cwiseMax(0.0).cwiseMin(1.0);
-    keys[i] = 0;
+    std::uint64_t key = 0;
     for (int axis = 0; axis < 3; ++axis) {
-      keys[i] |= SpreadBits(static_cast<std::uint32_t>(unit[axis] * (kDigits - 1))) << axis;
+      key |= SpreadBits(static_cast<std::uint32_t>(unit[axis] * (kDigits - 1))) << axis;
     }
-    order[i] = static_cast<std::uint32_t>(i);
+    entries[i] = key << 32 | i;
   }
-  std::vector<std::uint32_t> next(rays.size());
+  std::vector<std::uint64_t> next(rays.size());
   for (int pass = 0; pass < 3; ++pass) {
-    const int shift = pass * kDigitBits;
+    const int shift = 32 + pass * kDigitBits;
     std::vector<std::uint32_t> start(kDigits + 1, 0);
-    for (const std::uint32_t i : order) ++start[((keys[i] >> shift) & (kDigits - 1)) + 1];
+    for (const std::uint64_t entry : entries) ++start[((entry >> shift) & (kDigits - 1)) + 1];
     for (std::uint32_t d = 0; d < kDigits; ++d) start[d + 1] += start[d];
-    for (const std::uint32_t i : order) next[start[(keys[i] >> shift) & (kDigits - 1)]++] = i;
-    order.swap(next);
+    for (const std::uint64_t entry : entries) {
+      next[start[(entry >> shift) & (kDigits - 1)]++] = entry;
+    }
+    entries.swap(next);
+  }
+  std::vector<std::uint32_t> order(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    order[k] = static_cast<std::uint32_t>(entries[k] & 0xffffffffu);
   }
   return order;
 }
