@@ -131,11 +131,14 @@ sanitize: deps
 	  $(SANITIZE_TARGETS) -j$(JOBS) 2>&1 \
 	  | (grep --line-buffered -E '^\[ *[0-9]+%\]|[Ee]rror|warning|undefined' || true)
 	rm -f $(WS_ASAN)/asan.*
+	@# The gtests (one process each, nothing timed) run JOBS at a time; the
+	@# rostests one at a time, as each starts a master and a node.
 	cd $(WS_ASAN)/build && \
-	  ASAN_OPTIONS="detect_leaks=1 allocator_may_return_null=1 log_path=$(WS_ASAN)/asan" \
+	  export ASAN_OPTIONS="detect_leaks=1 allocator_may_return_null=1 log_path=$(WS_ASAN)/asan" \
 	  LSAN_OPTIONS="suppressions=$(ROOT)/test/node/lsan.supp" \
-	  UBSAN_OPTIONS="print_stacktrace=1 log_path=$(WS_ASAN)/asan" \
-	  ctest --output-on-failure -R 'gtest|rostest' -E node_scale
+	  UBSAN_OPTIONS="print_stacktrace=1 log_path=$(WS_ASAN)/asan" && \
+	  ctest --output-on-failure -R gtest -j$(JOBS) && \
+	  ctest --output-on-failure -R rostest -E node_scale
 	@if ls $(WS_ASAN)/asan.* > /dev/null 2>&1; then \
 	  cat $(WS_ASAN)/asan.*; echo "[sanitize] a sanitizer reported an error" >&2; exit 1; fi
 	@echo "[sanitize] no AddressSanitizer or UndefinedBehaviorSanitizer reports"
