@@ -73,10 +73,8 @@ class WideBoxTree {
   static WideBoxTree Build(const std::vector<Aabb>& boxes, const BuildSettings& settings,
                            std::vector<int>* order);
 
-  bool empty() const { return nodes_.empty(); }
   // The box of all the items (double, not rounded); zero when empty.
   const Aabb& bounds() const { return bounds_; }
-  std::size_t NodeCount() const { return nodes_.size(); }
 
   // Calls leaf(first, count) for the leaves the ray o + t d, 0 <= t <=
   // *reach, may enter, nearest entry first; a leaf may shorten *reach (to
