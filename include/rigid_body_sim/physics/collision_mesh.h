@@ -58,8 +58,9 @@ class CollisionMesh {
   // leaf items are triangle indices.
   const WideBoxTree& tree() const { return *tree_; }
 
-  const Vec3& lower() const { return lower_; }
-  const Vec3& upper() const { return upper_; }
+  // The box of every vertex (m, mesh frame): the tree's bounds.
+  const Vec3& lower() const;
+  const Vec3& upper() const;
   // The largest distance of a vertex from `center` (m).
   double BoundingRadius(const Vec3& center) const;
 
@@ -78,8 +79,6 @@ class CollisionMesh {
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
   std::shared_ptr<const WideBoxTree> tree_;
-  Vec3 lower_ = Vec3::Zero();  // m, mesh frame: the box of every vertex
-  Vec3 upper_ = Vec3::Zero();
 };
 
 }  // namespace rigid_body_sim::physics

@@ -197,15 +197,15 @@ void CollisionMesh::BuildTree() {
     centroids[t] = (vertices_[v[0]] + vertices_[v[1]] + vertices_[v[2]]) / 3.0;
   }
   std::vector<int> order;
-  auto tree = std::make_shared<WideBoxTree>(WideBoxTree::Build(
+  tree_ = std::make_shared<WideBoxTree>(WideBoxTree::Build(
       boxes, WideBoxTree::BuildSettings{kLeafTriangles, kSortedTriangles, &centroids}, &order));
-  lower_ = tree->bounds().min;
-  upper_ = tree->bounds().max;
-  tree_ = std::move(tree);
   std::vector<Triangle> sorted(triangles_.size());
   for (std::size_t i = 0; i < sorted.size(); ++i) sorted[i] = triangles_[order[i]];
   triangles_.swap(sorted);
 }
+
+const Vec3& CollisionMesh::lower() const { return tree_->bounds().min; }
+const Vec3& CollisionMesh::upper() const { return tree_->bounds().max; }
 
 double CollisionMesh::BoundingRadius(const Vec3& center) const {
   double radius_squared = 0.0;

@@ -77,9 +77,9 @@ WideBoxTree WideBoxTree::Build(const std::vector<Aabb>& boxes, const BuildSettin
 
 // A node's children: its range halved, then the larger halves halved
 // again, until four ranges or every range fits a leaf; a range larger than
-// a leaf becomes an inner child, built depth first.
-// The ranges are split in the order a binary median split would split
-// them, so a mesh's triangles keep the order its binary tree gave them.
+// a leaf becomes an inner child, built depth first. Each range is split as
+// a binary median split would split it, so a mesh's triangles keep the
+// order its binary tree gave them.
 int WideBoxTree::BuildNode(const BuildInput& input, int begin, int end, std::vector<int>* order) {
   const std::vector<Aabb>& boxes = input.boxes;
   const int leaf_size = input.settings.leaf_size;
