@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "io/voxel_grid.h"
+
 namespace rigid_body_sim::io {
 namespace {
 
@@ -16,158 +18,42 @@ using physics::Result;
 using physics::Status;
 using physics::TriangleMesh;
 using physics::Vec3;
-using Index3 = Eigen::Array3i;
 
-// Cut planes tried per axis in the coarse search; then every voxel layer
-// between the best plane's neighbours is tried (V-HACD's coarse-to-fine
-// plane search, Game Engine Gems 3, ch. 11).
+// Cut planes tried per axis in the coarse search; then layers about the best
+// one, at half the distance each round (V-HACD's coarse-to-fine plane
+// search, Game Engine Gems 3, ch. 11, with a bisection for its fine pass).
 constexpr int kCoarsePlanes = 12;
 // Points at most in the hulls that rank candidate planes.
 constexpr std::size_t kSearchPoints = 256;
+// The grid's voxels at most when thin walls refine it (the voxel_count
+// option's own upper bound).
+constexpr double kMaxGridVoxels = 4e6;
+// Far voxels at most that a rough evaluation tests.
+constexpr std::size_t kSearchFar = 4096;
+// Weight of the far volume a candidate cut's halves still cover, in the
+// energy of a piece that covers far voxels: above the concavity's own weight
+// (which counts that volume once), so such a piece is cut to open the
+// cavity first.
+constexpr double kBridgeWeight = 10.0;
+// Counts every far voxel in a hull.
+constexpr int kAll = std::numeric_limits<int>::max();
 
-// Voxels [lower, upper) per axis: a box of the grid, and the part of the
-// mesh inside it.
-struct Cell {
-  Index3 lower = Index3::Zero();
-  Index3 upper = Index3::Zero();
-};
-
-// The height at which the vertical line through (x, y) crosses triangle
-// abc, when it crosses its interior. Barycentric coordinates of the xy
-// projection; a line through an edge or a vertex, or a vertical triangle,
-// is no crossing (callers nudge their lines off the grid's symmetries).
-std::optional<double> VerticalCrossing(const Vec3& a, const Vec3& b, const Vec3& c, double x,
-                                       double y) {
-  const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
-  if (area == 0.0) return std::nullopt;
-  const double w_b = ((x - a.x()) * (c.y() - a.y()) - (y - a.y()) * (c.x() - a.x())) / area;
-  const double w_c = ((b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x())) / area;
-  const double w_a = 1.0 - w_b - w_c;
-  if (!(w_a > 0.0 && w_b > 0.0 && w_c > 0.0)) return std::nullopt;
-  return w_a * a.z() + w_b * b.z() + w_c * c.z();
+// The volume of a convex polyhedron by the divergence theorem with F = x / 3:
+// V = (1/3) sum over faces of offset * area, each face's area from its
+// polygon's fan, without triangulating it into a mesh.
+double HullVolume(const ConvexPolyhedron& hull) {
+  double volume = 0.0;
+  for (int f = 0; f < static_cast<int>(hull.faces.size()); ++f) {
+    const std::vector<int> loop = hull.FaceVertices(f);
+    Vec3 twice_area = Vec3::Zero();
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+      twice_area += (hull.vertices[loop[i]] - hull.vertices[loop[0]])
+                        .cross(hull.vertices[loop[i + 1]] - hull.vertices[loop[0]]);
+    }
+    volume += hull.faces[f].offset * hull.faces[f].normal.dot(twice_area) / 6.0;
+  }
+  return volume;
 }
-
-// Occupancy of the voxels whose centres lie inside the mesh, with a 3-D
-// prefix sum so the voxels of any cell count in constant time. Interior fill
-// by ray parity: the vertical line through each column's centre crosses the
-// closed surface an even number of times, and a centre is inside when an odd
-// number of crossings lie below it.
-class VoxelGrid {
- public:
-  VoxelGrid(const TriangleMesh& mesh, int voxel_count) {
-    Vec3 lower = mesh.vertices.front();
-    Vec3 upper = lower;
-    for (const Vec3& vertex : mesh.vertices) {
-      lower = lower.cwiseMin(vertex);
-      upper = upper.cwiseMax(vertex);
-    }
-    const Vec3 extent = upper - lower;
-    const double count = voxel_count;
-    // Cubic voxels; a flat mesh keeps at most sqrt(count) layers per axis.
-    size_ = std::max(std::cbrt(extent.prod() / count), extent.maxCoeff() / std::sqrt(count));
-    for (int k = 0; k < 3; ++k) cells_[k] = static_cast<int>(std::floor(extent[k] / size_)) + 1;
-    // Centred: the grid overhangs the mesh equally on both sides, so a
-    // symmetric mesh gets symmetric voxels.
-    origin_ = lower - 0.5 * (cells_.cast<double>().matrix() * size_ - extent);
-    nudge_ = size_ * 1e-5 * Vec3(0.7548776662, 0.5698402910, 0.0);
-    Fill(mesh);
-  }
-
-  double size() const { return size_; }
-  const Vec3& nudge() const { return nudge_; }
-  Cell Whole() const { return Cell{Index3::Zero(), cells_}; }
-  Vec3 Corner(const Index3& index) const { return origin_ + size_ * index.cast<double>().matrix(); }
-
-  int Count(const Cell& cell) const {
-    const Index3& l = cell.lower;
-    const Index3& u = cell.upper;
-    return Sum(u[0], u[1], u[2]) - Sum(l[0], u[1], u[2]) - Sum(u[0], l[1], u[2]) -
-           Sum(u[0], u[1], l[2]) + Sum(l[0], l[1], u[2]) + Sum(l[0], u[1], l[2]) +
-           Sum(u[0], l[1], l[2]) - Sum(l[0], l[1], l[2]);
-  }
-
-  // The smallest cell inside `cell` that holds all of its voxels.
-  Cell Occupied(const Cell& cell) const {
-    Cell tight = cell;
-    for (int axis = 0; axis < 3; ++axis) {
-      Cell slab = tight;
-      for (slab.upper[axis] = slab.lower[axis] + 1;
-           tight.lower[axis] < tight.upper[axis] && Count(slab) == 0; ++slab.upper[axis]) {
-        slab.lower[axis] = ++tight.lower[axis];
-      }
-      slab = tight;
-      for (slab.lower[axis] = slab.upper[axis] - 1;
-           tight.upper[axis] > tight.lower[axis] && Count(slab) == 0; --slab.lower[axis]) {
-        slab.upper[axis] = --tight.upper[axis];
-      }
-    }
-    return tight;
-  }
-
- private:
-  int Sum(int i, int j, int k) const { return prefix_[Index(i, j, k)]; }
-  std::size_t Index(int i, int j, int k) const {
-    return (static_cast<std::size_t>(i) * (cells_[1] + 1) + j) * (cells_[2] + 1) + k;
-  }
-
-  void Fill(const TriangleMesh& mesh) {
-    const int nx = cells_[0];
-    const int ny = cells_[1];
-    const int nz = cells_[2];
-    std::vector<std::vector<double>> crossings(static_cast<std::size_t>(nx) * ny);
-    const auto column = [&](double coordinate, int axis) {
-      return (coordinate - origin_[axis] - nudge_[axis]) / size_ - 0.5;
-    };
-    for (const Eigen::Vector3i& triangle : mesh.triangles) {
-      const Vec3& a = mesh.vertices[triangle[0]];
-      const Vec3& b = mesh.vertices[triangle[1]];
-      const Vec3& c = mesh.vertices[triangle[2]];
-      const Vec3 low = a.cwiseMin(b).cwiseMin(c);
-      const Vec3 high = a.cwiseMax(b).cwiseMax(c);
-      const int i0 = std::max(0, static_cast<int>(std::floor(column(low.x(), 0))));
-      const int i1 = std::min(nx - 1, static_cast<int>(std::ceil(column(high.x(), 0))));
-      const int j0 = std::max(0, static_cast<int>(std::floor(column(low.y(), 1))));
-      const int j1 = std::min(ny - 1, static_cast<int>(std::ceil(column(high.y(), 1))));
-      for (int i = i0; i <= i1; ++i) {
-        for (int j = j0; j <= j1; ++j) {
-          const Vec3 centre = Corner(Index3(i, j, 0)) + Vec3(0.5, 0.5, 0.0) * size_ + nudge_;
-          if (const auto z = VerticalCrossing(a, b, c, centre.x(), centre.y())) {
-            crossings[static_cast<std::size_t>(i) * ny + j].push_back(*z);
-          }
-        }
-      }
-    }
-    prefix_.assign(static_cast<std::size_t>(nx + 1) * (ny + 1) * (nz + 1), 0);
-    for (int i = 0; i < nx; ++i) {
-      for (int j = 0; j < ny; ++j) {
-        std::vector<double>& heights = crossings[static_cast<std::size_t>(i) * ny + j];
-        std::sort(heights.begin(), heights.end());
-        std::size_t below = 0;
-        for (int k = 0; k < nz; ++k) {
-          const double z = origin_.z() + (k + 0.5) * size_;
-          while (below < heights.size() && heights[below] < z) ++below;
-          prefix_[Index(i + 1, j + 1, k + 1)] = (below % 2 == 1 ? 1 : 0);
-        }
-      }
-    }
-    // Summed in place along each axis in turn.
-    for (int i = 1; i <= nx; ++i) {
-      for (int j = 1; j <= ny; ++j) {
-        for (int k = 1; k <= nz; ++k) {
-          prefix_[Index(i, j, k)] += Sum(i - 1, j, k) + Sum(i, j - 1, k) + Sum(i, j, k - 1) -
-                                     Sum(i - 1, j - 1, k) - Sum(i - 1, j, k - 1) -
-                                     Sum(i, j - 1, k - 1) + Sum(i - 1, j - 1, k - 1);
-        }
-      }
-    }
-  }
-
-  Vec3 origin_ = Vec3::Zero();
-  Vec3 nudge_ = Vec3::Zero();
-  double size_ = 0.0;  // m, the voxels' edge
-  Index3 cells_ = Index3::Ones();
-  std::vector<int> prefix_;
-};
 
 // Sutherland-Hodgman clipping of a planar polygon to the half-space
 // side * (x[axis] - value) >= 0 (Sutherland, Hodgman, "Reentrant Polygon
@@ -194,16 +80,22 @@ void ClipToHalfSpace(const std::vector<Vec3>& polygon, int axis, double value, d
 class Decomposer {
  public:
   struct Piece {
-    Cell cell;
+    VoxelCell cell;
     std::optional<ConvexPolyhedron> hull;  // none when the part is flat
     double volume = 0.0;                   // m^3, of the mesh inside the cell
     double hull_volume = 0.0;              // m^3
     double concavity = 0.0;                // m^3, hull_volume - volume, >= 0
+    int bridged = 0;                       // far voxels inside the hull
     bool final = false;                    // no cut divides its voxels
   };
 
   Decomposer(const TriangleMesh& mesh, const DecompositionOptions& options, double volume)
-      : mesh_(mesh), options_(options), grid_(mesh, options.voxel_count), volume_(volume) {
+      : mesh_(mesh),
+        options_(options),
+        volume_(volume),
+        orientation_(Orientation(mesh)),
+        thickness_(WallThickness(mesh, orientation_)),
+        grid_(mesh, GridVoxels(mesh, options.voxel_count, thickness_)) {
     for (const Eigen::Vector3i& triangle : mesh.triangles) {
       const Vec3& a = mesh.vertices[triangle[0]];
       const Vec3& b = mesh.vertices[triangle[1]];
@@ -211,22 +103,39 @@ class Decomposer {
       bounds_.push_back({a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)});
       all_triangles_.push_back(static_cast<int>(all_triangles_.size()));
     }
-    orientation_ = SignedVolume(grid_.Corner(grid_.Whole().lower),
-                                grid_.Corner(grid_.Whole().upper), all_triangles_) < 0.0
-                       ? -1.0
-                       : 1.0;
+    // A point farther than one wall thickness T from the surface lies in a
+    // voxel whose centre is farther than T - sqrt(3) s from every occupied
+    // voxel's centre (half a diagonal s sqrt(3) / 2 from the point to its
+    // centre, and as much from an occupied centre to the surface in it).
+    const double s = grid_.size();
+    if (thickness_ > 0.0) grid_.MarkFar(std::max(thickness_ - 0.5 * std::sqrt(3.0) * s, 0.5 * s));
+    far_stride_ = std::max<int>(1, static_cast<int>(grid_.FarCount() / kSearchFar));
   }
 
+  // Cuts the most concave piece while the pieces number under max_pieces,
+  // then the one that covers the most far voxels while they number under
+  // kMaxCavityPieces; merges last.
   std::vector<Piece> Run() {
     std::vector<Piece> pieces = {Evaluate(grid_.Whole(), all_triangles_)};
     const double most = options_.max_concavity * volume_;
-    while (static_cast<int>(pieces.size()) < options_.max_pieces) {
+    const auto worst_by = [&pieces](auto measure, double above) {
       int worst = -1;
       for (int i = 0; i < static_cast<int>(pieces.size()); ++i) {
-        if (!pieces[i].final && pieces[i].concavity > most &&
-            (worst < 0 || pieces[i].concavity > pieces[worst].concavity)) {
+        if (!pieces[i].final && measure(pieces[i]) > above &&
+            (worst < 0 || measure(pieces[i]) > measure(pieces[worst]))) {
           worst = i;
         }
+      }
+      return worst;
+    };
+    for (;;) {
+      const int count = static_cast<int>(pieces.size());
+      int worst = -1;
+      if (count < options_.max_pieces) {
+        worst = worst_by([](const Piece& piece) { return piece.concavity; }, most);
+      }
+      if (worst < 0 && count < kMaxCavityPieces) {
+        worst = worst_by([](const Piece& piece) { return double(piece.bridged); }, 0.0);
       }
       if (worst < 0) break;
       std::optional<std::pair<Piece, Piece>> halves = BestCut(pieces[worst]);
@@ -239,6 +148,32 @@ class Decomposer {
     }
     Merge(&pieces);
     return pieces;
+  }
+
+ private:
+  // +1 for a mesh wound outward (positive signed volume), else -1.
+  static double Orientation(const TriangleMesh& mesh) {
+    double six_volume = 0.0;
+    for (const Eigen::Vector3i& t : mesh.triangles) {
+      six_volume += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
+    }
+    return six_volume < 0.0 ? -1.0 : 1.0;
+  }
+
+  // Voxels enough for an edge of at most a third of the wall thickness, so a
+  // wall is at least three voxels thick, and at least `voxel_count`; at most
+  // kMaxGridVoxels.
+  static int GridVoxels(const TriangleMesh& mesh, int voxel_count, double thickness) {
+    if (!(thickness > 0.0)) return voxel_count;
+    Vec3 lower = mesh.vertices.front();
+    Vec3 upper = lower;
+    for (const Vec3& vertex : mesh.vertices) {
+      lower = lower.cwiseMin(vertex);
+      upper = upper.cwiseMax(vertex);
+    }
+    const Vec3 cells = (upper - lower) / (thickness / 2.5);
+    const double needed = std::max(cells.prod(), cells.maxCoeff() * cells.maxCoeff());
+    return static_cast<int>(std::clamp(needed, double(voxel_count), double(kMaxGridVoxels)));
   }
 
  private:
@@ -302,7 +237,7 @@ class Decomposer {
   // The triangles that can matter to a cell or any cell inside it: those
   // over its xy-rectangle that reach above its floor (the volume integral
   // and the inside test look up the column).
-  std::vector<int> ColumnTriangles(const Cell& cell) const {
+  std::vector<int> ColumnTriangles(const VoxelCell& cell) const {
     const Vec3 lower = grid_.Corner(cell.lower);
     const Vec3 upper = grid_.Corner(cell.upper);
     std::vector<int> triangles;
@@ -340,7 +275,8 @@ class Decomposer {
   // plane search, hulls at most kSearchPoints of them, evenly strided (the
   // paper's downsampled hulls): its concavity ranks planes, the chosen cut's
   // pieces are evaluated in full.
-  Piece Evaluate(const Cell& cell, const std::vector<int>& triangles, bool rough = false) const {
+  Piece Evaluate(const VoxelCell& cell, const std::vector<int>& triangles,
+                 bool rough = false) const {
     Piece piece;
     piece.cell = cell;
     const Vec3 lower = grid_.Corner(cell.lower);
@@ -382,9 +318,10 @@ class Decomposer {
     if (rough) hull_options.max_vertices = static_cast<int>(kSearchPoints);
     Result<ConvexPolyhedron> hull = ComputeConvexHull(points, hull_options);
     if (hull.ok()) {
-      piece.hull_volume = physics::PolyhedronMassProperties(1.0, *hull).mass;
+      piece.hull_volume = HullVolume(*hull);
       piece.hull = std::move(hull).value();
       piece.concavity = std::max(0.0, piece.hull_volume - piece.volume);
+      piece.bridged = grid_.FarInside(*piece.hull, cell, kAll, rough ? far_stride_ : 1);
     }
     return piece;
   }
@@ -393,7 +330,7 @@ class Decomposer {
   // V_right| / V over axis-aligned planes on voxel layers, both sides
   // holding voxels; none when no plane divides the piece's voxels.
   std::optional<std::pair<Piece, Piece>> BestCut(const Piece& piece) const {
-    const Cell occupied = grid_.Occupied(piece.cell);
+    const VoxelCell occupied = grid_.Occupied(piece.cell);
     const std::vector<int> triangles = ColumnTriangles(piece.cell);
     const double voxel_volume = std::pow(grid_.size(), 3);
     std::optional<std::pair<Piece, Piece>> best;
@@ -401,8 +338,8 @@ class Decomposer {
     int best_axis = -1;
     int best_layer = -1;
     const auto try_cut = [&](int axis, int layer) {
-      Cell left = piece.cell;
-      Cell right = piece.cell;
+      VoxelCell left = piece.cell;
+      VoxelCell right = piece.cell;
       left.upper[axis] = layer;
       right.lower[axis] = layer;
       const int left_voxels = grid_.Count(left);
@@ -412,7 +349,9 @@ class Decomposer {
       Piece r = Evaluate(right, triangles, /*rough=*/true);
       const double energy =
           (l.concavity + r.concavity) / volume_ +
-          options_.balance_weight * voxel_volume * std::abs(left_voxels - right_voxels) / volume_;
+          options_.balance_weight * voxel_volume * std::abs(left_voxels - right_voxels) / volume_ +
+          (piece.bridged > 0 ? kBridgeWeight * voxel_volume * (l.bridged + r.bridged) / volume_
+                             : 0.0);
       if (energy < best_energy) {
         best_energy = energy;
         best_axis = axis;
@@ -429,12 +368,14 @@ class Decomposer {
         try_cut(axis, layer);
       }
     }
-    if (best_axis >= 0 && steps[best_axis] > 1) {
-      const int centre = best_layer;
-      for (int layer = centre - steps[best_axis] + 1; layer < centre + steps[best_axis]; ++layer) {
-        if (layer != centre && layer > occupied.lower[best_axis] &&
-            layer < occupied.upper[best_axis]) {
-          try_cut(best_axis, layer);
+    // Then about the best plane on its axis, the interval halved each round.
+    if (best_axis >= 0) {
+      const int axis = best_axis;
+      for (int step = steps[axis]; step > 1;) {
+        step = (step + 1) / 2;
+        const int centre = best_layer;
+        for (const int layer : {centre - step, centre + step}) {
+          if (layer > occupied.lower[axis] && layer < occupied.upper[axis]) try_cut(axis, layer);
         }
       }
     }
@@ -455,8 +396,7 @@ class Decomposer {
     points.insert(points.end(), b.hull->vertices.begin(), b.hull->vertices.end());
     Result<ConvexPolyhedron> hull = ComputeConvexHull(points, options_.hull);
     if (!hull.ok()) return std::nullopt;
-    const double added =
-        physics::PolyhedronMassProperties(1.0, *hull).mass - a.hull_volume - b.hull_volume;
+    const double added = HullVolume(*hull) - a.hull_volume - b.hull_volume;
     return std::make_pair(added, std::move(hull).value());
   }
 
@@ -470,6 +410,8 @@ class Decomposer {
       if (!joint || a.concavity + b.concavity + joint->first > options_.max_concavity * volume_) {
         return inf;
       }
+      VoxelCell both{a.cell.lower.min(b.cell.lower), a.cell.upper.max(b.cell.upper)};
+      if (grid_.FarInside(joint->second, both, 1) > 0) return inf;
       return joint->first;
     };
     std::vector<std::vector<double>> costs(pieces->size(),
@@ -515,9 +457,11 @@ class Decomposer {
 
   const TriangleMesh& mesh_;
   const DecompositionOptions& options_;
+  double volume_;       // m^3, the mesh's
+  double orientation_;  // -1 for a mesh wound inside out
+  double thickness_;    // m, WallThickness; 0 when unknown
   VoxelGrid grid_;
-  double volume_;                              // m^3, the mesh's
-  double orientation_ = 1.0;                   // -1 for a mesh wound inside out
+  int far_stride_ = 1;                         // of the far voxels a rough evaluation tests
   std::vector<std::pair<Vec3, Vec3>> bounds_;  // per triangle
   std::vector<int> all_triangles_;             // 0, 1, ..., triangle count - 1
   // Per vertex, the last Evaluate that took it.
@@ -571,7 +515,7 @@ Result<std::vector<ConvexPolyhedron>> ConvexPieces(const TriangleMesh& mesh,
     Result<ConvexPolyhedron> hull = ComputeConvexHull(mesh.vertices, options.hull);
     if (!hull.ok()) return hull.status();
     Result<physics::MassProperties> mass = physics::TriangleMeshMassProperties(1.0, mesh);
-    const double hull_volume = physics::PolyhedronMassProperties(1.0, *hull).mass;
+    const double hull_volume = HullVolume(*hull);
     // An open mesh bounds no volume: its hull is all there is to collide.
     if (!mass.ok() || mass->mass >= options.convex_ratio * hull_volume ||
         mesh.triangles.size() > kMaxAutoTriangles) {

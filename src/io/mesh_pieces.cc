@@ -43,10 +43,12 @@ std::string Quoted(const std::string& text) { return "'" + text + "'"; }
 const char* RuleName(PiecesRule rule) { return rule == PiecesRule::kAuto ? "auto" : "always"; }
 
 // Every setting the pieces depend on, in one line; the disk cache's key
-// holds it whole, so two settings never share a cache file.
+// holds it whole, so two settings never share a cache file. Its leading
+// version names the decomposition algorithm: v2 keeps thin-walled cavities
+// open, so the pieces that v1 cached are not reused.
 std::string SettingsLine(const MeshPiecesRequest& request) {
   const DecompositionOptions& o = request.options;
-  return "v1 scale " + HexFloat(request.scale.x()) + " " + HexFloat(request.scale.y()) + " " +
+  return "v2 scale " + HexFloat(request.scale.x()) + " " + HexFloat(request.scale.y()) + " " +
          HexFloat(request.scale.z()) + " rule " + RuleName(request.rule) + " voxels " +
          std::to_string(o.voxel_count) + " pieces " + std::to_string(o.max_pieces) + " concavity " +
          HexFloat(o.max_concavity) + " balance " + HexFloat(o.balance_weight) + " merge " +

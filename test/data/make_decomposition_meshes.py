@@ -5,6 +5,8 @@ mug.stl: a cup around the z axis, outer radius 4 cm, inner radius 3.5 cm,
 10 cm tall with a 1 cm floor (the cavity from z = 0.01 to 0.10), circles of
 32 vertices; one watertight surface (256 triangles): outside, rim, cavity
 wall, cavity floor and base.
+mug_thin.stl: the same with 4 mm walls (inner radius 3.6 cm) and a 5 mm
+floor: its volume is 0.23 of its hull's.
 l_bracket.stl: an L of profile (x, z) (0,0) (0.3,0) (0.3,0.05) (0.05,0.05)
 (0.05,0.3) (0,0.3) extruded over y in [0, 0.1] (20 triangles): two legs
 30 cm long and 5 cm thick.
@@ -65,4 +67,6 @@ def l_bracket(length, height, thickness, depth):
 if __name__ == "__main__":
     writer = "make_decomposition_meshes.py"
     write_binary_stl(os.path.join(HERE, "mug.stl"), *mug(0.04, 0.035, 0.10, 0.01, 32), writer)
+    write_binary_stl(os.path.join(HERE, "mug_thin.stl"), *mug(0.04, 0.036, 0.10, 0.005, 32),
+                     writer)
     write_binary_stl(os.path.join(HERE, "l_bracket.stl"), *l_bracket(0.3, 0.3, 0.05, 0.1), writer)

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "rigid_body_sim/physics/mass_properties.h"
@@ -89,6 +90,63 @@ inline physics::TriangleMesh Cup(double outer, double inner, double height, doub
     mesh.triangles.emplace_back(bottom_centre, outer_bottom + j, outer_bottom + i);    // base
   }
   return mesh;
+}
+
+// A closed surface of revolution about the z axis: the profile is a simple
+// polygon of (r, z) points, r >= 0, whose points on the axis (r = 0) become
+// single vertices; circles of `segments` vertices. Wound outward whichever
+// way the profile runs (the signed volume decides).
+inline physics::TriangleMesh Revolve(const std::vector<std::array<double, 2>>& profile,
+                                     int segments) {
+  physics::TriangleMesh mesh;
+  std::vector<int> first(profile.size());
+  for (std::size_t p = 0; p < profile.size(); ++p) {
+    first[p] = static_cast<int>(mesh.vertices.size());
+    const int copies = profile[p][0] == 0.0 ? 1 : segments;
+    for (int i = 0; i < copies; ++i) {
+      const double angle = 2.0 * M_PI * i / segments;
+      mesh.vertices.emplace_back(profile[p][0] * std::cos(angle), profile[p][0] * std::sin(angle),
+                                 profile[p][1]);
+    }
+  }
+  const auto at = [&](std::size_t p, int i) {
+    return profile[p][0] == 0.0 ? first[p] : first[p] + i % segments;
+  };
+  for (std::size_t p = 0; p < profile.size(); ++p) {
+    const std::size_t q = (p + 1) % profile.size();
+    for (int i = 0; i < segments; ++i) {
+      const int a = at(p, i), b = at(p, i + 1), c = at(q, i + 1), d = at(q, i);
+      if (a != b) mesh.triangles.emplace_back(a, b, c);
+      if (c != d) mesh.triangles.emplace_back(a, c, d);
+    }
+  }
+  double signed_volume = 0.0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    signed_volume += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
+  }
+  if (signed_volume < 0.0) {
+    for (Eigen::Vector3i& t : mesh.triangles) std::swap(t[1], t[2]);
+  }
+  return mesh;
+}
+
+// A hemispherical bowl, open at the top: outer radius `outer`, walls
+// `wall` thick, its lowest point at z = 0 and its rim at z = outer;
+// `rings` profile points per arc.
+inline physics::TriangleMesh Bowl(double outer, double wall, int rings, int segments) {
+  std::vector<std::array<double, 2>> profile;
+  for (int k = 0; k <= rings; ++k) {  // outside, from the bottom up to the rim
+    const double angle = -0.5 * M_PI * (1.0 - static_cast<double>(k) / rings);
+    profile.push_back({outer * std::cos(angle), outer + outer * std::sin(angle)});
+  }
+  const double inner = outer - wall;
+  for (int k = rings; k >= 0; --k) {  // inside, from the rim down
+    const double angle = -0.5 * M_PI * (1.0 - static_cast<double>(k) / rings);
+    profile.push_back({inner * std::cos(angle), outer + inner * std::sin(angle)});
+  }
+  profile.front()[0] = 0.0;
+  profile.back()[0] = 0.0;
+  return Revolve(profile, segments);
 }
 
 // The area of a regular polygon of `segments` vertices on a circle.

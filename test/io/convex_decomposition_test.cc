@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <functional>
 #include <vector>
 
 #include "concave_meshes.h"
@@ -103,6 +106,92 @@ TEST(ConvexDecompositionTest, CupPiecesLeaveTheCavityOpen) {
         }
       }
     }
+  }
+}
+
+// The sample points of a cavity farther than `wall` from its walls (a grid
+// of `step`) that lie inside some piece: none, for pieces that keep the
+// cavity open.
+int CoveredCavityPoints(const std::vector<ConvexPolyhedron>& pieces,
+                        const std::vector<Vec3>& cavity) {
+  int covered = 0;
+  for (const Vec3& point : cavity) {
+    for (const ConvexPolyhedron& piece : pieces) {
+      if (Contains(piece, point)) {
+        ++covered;
+        break;
+      }
+    }
+  }
+  return covered;
+}
+
+std::vector<Vec3> GridPoints(const Vec3& lower, const Vec3& upper, double step,
+                             const std::function<bool(const Vec3&)>& keep) {
+  std::vector<Vec3> points;
+  for (double x = lower.x(); x <= upper.x(); x += step) {
+    for (double y = lower.y(); y <= upper.y(); y += step) {
+      for (double z = lower.z(); z <= upper.z(); z += step) {
+        if (keep(Vec3(x, y, z))) points.emplace_back(x, y, z);
+      }
+    }
+  }
+  return points;
+}
+
+// A mug 8 cm wide, 10 cm tall, with 4 mm walls and a 5 mm floor, 32
+// segments; its volume is 0.23 of its hull's. And a hemispherical bowl 12 cm
+// wide with 3 mm walls. Every point of the cavity more than one wall
+// thickness from the walls, up to the rim, lies in no piece; the pieces
+// still cover the part.
+TEST(ConvexDecompositionTest, ThinWalledPartsKeepTheirCavityOpen) {
+  struct Part {
+    const char* name;
+    physics::TriangleMesh mesh;
+    std::vector<Vec3> cavity;
+  };
+  const double step = 0.002;
+  std::vector<Part> parts;
+  parts.push_back(
+      {"mug", testing::Cup(0.04, 0.036, 0.10, 0.005, 32),
+       GridPoints(Vec3(-0.04, -0.04, 0.0), Vec3(0.04, 0.04, 0.10), step, [](const Vec3& p) {
+         return p.head<2>().norm() <= 0.036 - 0.004 && p.z() >= 0.009;
+       })});
+  parts.push_back(
+      {"bowl", testing::Bowl(0.06, 0.003, 16, 32),
+       GridPoints(Vec3(-0.06, -0.06, 0.0), Vec3(0.06, 0.06, 0.06), step,
+                  [](const Vec3& p) { return (p - Vec3(0, 0, 0.06)).norm() <= 0.057 - 0.003; })});
+  // The mug again with ten rings up its walls, and moved off the origin and
+  // turned off the grid's axes: its cavity stays open however it is
+  // tessellated and placed.
+  std::vector<std::array<double, 2>> profile = {{0.0, 0.0}};
+  for (int k = 0; k <= 10; ++k) profile.push_back({0.04, 0.01 * k});
+  for (int k = 10; k >= 0; --k) profile.push_back({0.036, 0.005 + 0.0095 * k});
+  profile.push_back({0.0, 0.005});
+  parts.push_back({"mug_rings", testing::Revolve(profile, 32), parts[0].cavity});
+  const Eigen::Isometry3d moved =
+      Eigen::Translation3d(0.013, -0.021, 0.0) * Eigen::AngleAxisd(0.3, Vec3::UnitZ());
+  Part shifted{"mug_moved", parts[0].mesh, parts[0].cavity};
+  for (Vec3& vertex : shifted.mesh.vertices) vertex = moved * vertex;
+  for (Vec3& point : shifted.cavity) point = moved * point;
+  parts.push_back(std::move(shifted));
+  for (const Part& part : parts) {
+    const auto mass = physics::TriangleMeshMassProperties(1.0, part.mesh);
+    ASSERT_TRUE(mass.ok()) << part.name << ": " << mass.message();
+    const auto start = std::chrono::steady_clock::now();
+    const auto pieces = ConvexPieces(part.mesh, DecompositionOptions{}, PiecesRule::kAuto);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_TRUE(pieces.ok()) << pieces.message();
+    const int covered = CoveredCavityPoints(*pieces, part.cavity);
+    std::printf(
+        "%s (%zu triangles): %zu pieces, %.4g m^3 of %.4g m^3, %d of %zu cavity points "
+        "covered, %.3f s\n",
+        part.name, part.mesh.triangles.size(), pieces->size(), TotalVolume(*pieces), mass->mass,
+        covered, part.cavity.size(), seconds);
+    EXPECT_EQ(covered, 0) << part.name;
+    EXPECT_GE(TotalVolume(*pieces), mass->mass * (1.0 - 1e-9)) << part.name;
+    for (const ConvexPolyhedron& piece : *pieces) testing::ExpectValidConvexPolyhedron(piece, 1e-9);
   }
 }
 

@@ -180,7 +180,7 @@ class DecompositionCacheTest : public ::testing::Test {
 
 TEST_F(DecompositionCacheTest, EntryIsTheVersionedChecksummedHelperReply) {
   const std::string& text = reference->entry_text;
-  EXPECT_EQ(text.rfind("rigid_body_sim decomposition cache 2\nkey v1 scale ", 0), 0u) << text;
+  EXPECT_EQ(text.rfind("rigid_body_sim decomposition cache 2\nkey v2 scale ", 0), 0u) << text;
   const std::size_t body_line = text.find("\nbody ") + 1;
   const std::string body = text.substr(text.find('\n', body_line) + 1);
   EXPECT_EQ(body.rfind("pieces ", 0), 0u);
@@ -240,7 +240,7 @@ TEST_F(DecompositionCacheTest, OtherVersionIsRebuilt) {
 }
 
 TEST_F(DecompositionCacheTest, OtherSettingsAreRebuilt) {
-  WriteFile(entry_, Edited("\nkey v1 scale ", "\nkey v1 scale 0x1p+1 "));
+  WriteFile(entry_, Edited("\nkey v2 scale ", "\nkey v2 scale 0x1p+1 "));
   ExpectRebuiltWithOneWarning("it holds other settings");
 }
 
@@ -262,7 +262,7 @@ TEST_F(DecompositionCacheTest, UnversionedEntryIsRebuiltSilently) {
   const std::string& text = reference->entry_text;
   const std::string body = text.substr(text.find('\n', text.find("\nbody ") + 1) + 1);
   WriteFile(entry_, "key " + Settings() + "\n" + body);
-  ASSERT_EQ(ReadFile(entry_).rfind("key v1 scale ", 0), 0u);
+  ASSERT_EQ(ReadFile(entry_).rfind("key v2 scale ", 0), 0u);
   const Outcome rebuilt = Load(request_, HelperLimits());
   ASSERT_TRUE(rebuilt.pieces.ok()) << rebuilt.pieces.message();
   EXPECT_LT(rebuilt.seconds, kMaxSeconds);

@@ -80,40 +80,54 @@ class ConcaveTest(unittest.TestCase):
         self.assertTrue(state.success, state.message)
         return state
 
-    def test_mug_holds_a_ball_and_its_second_spawn_is_fast(self):
-        mug = mesh_urdf('mug', os.path.join(self.data, 'mug.stl'))
-        # Upright at (0, 5) on the ground; the ball (radius 1 cm) above the
-        # cavity, whose floor is 1 cm above the mug's base.
-        self.spawn('mug', urdf=mug, at=pose(0.0, 5.0, 0.001))
+    def check_mug_holds_a_ball(self, name, inner, floor, x):
+        """A mug of test/data (outer radius 4 cm, 10 cm tall, 32 segments) and a
+        cached second spawn of it, each holding a 2 cm ball dropped in."""
+        mug = mesh_urdf(name, os.path.join(self.data, name + '.stl'))
+        # Upright on the ground; the balls (radius 1 cm) above the cavities,
+        # whose floor is `floor` above the mug's base.
+        self.spawn(name, urdf=mug, at=pose(x, 5.0, 0.001))
         started = time.monotonic()
-        self.spawn('mug_again', urdf=mug, at=pose(1.0, 5.0, 0.001))
+        self.spawn(name + '_again', urdf=mug, at=pose(x + 1.0, 5.0, 0.001))
         second = time.monotonic() - started
-        rospy.loginfo('second spawn of the decomposed mug: %.1f ms', 1000 * second)
+        rospy.loginfo('second spawn of the decomposed %s: %.1f ms', name, 1000 * second)
         self.assertLess(second, 0.05)
-        self.spawn('marble', urdf=primitive_urdf('marble', '<sphere radius="0.01"/>'),
-                   at=pose(0.003, 5.002, 0.07))
+        for mug_name, mug_x in ((name, x), (name + '_again', x + 1.0)):
+            self.spawn(mug_name + '_marble',
+                       urdf=primitive_urdf('marble', '<sphere radius="0.01"/>'),
+                       at=pose(mug_x + 0.003, 5.002, 0.07))
         self.run_for(2.0)
-        mug_position = self.state('mug').pose.position
-        ball = self.state('marble').pose.position
-        # The ball rests on the cavity floor: its centre one radius above
-        # z = 0.01, inside the 3.5 cm cavity wall. The pieces may raise the
-        # floor: a floor piece's hull exceeds its part by at most 1 % of the
-        # mug's volume V (max_concavity), so over a quarter of the cavity's
-        # floor area A it rises at most 0.01 V / (A / 4). The mug's hull
-        # would have held the ball on the rim's lid at z = 0.11.
+        # Each ball rests on its cavity floor: its centre one radius above
+        # z = floor, inside the cavity wall. The pieces may raise the floor:
+        # a floor piece's hull exceeds its part by at most 1 % of the mug's
+        # volume V (max_concavity), so over a quarter of the cavity's floor
+        # area A it rises at most 0.01 V / (A / 4). The mug's hull would
+        # have held the ball on the rim's lid at z = 0.11.
         segments = 32
         area = 0.5 * segments * math.sin(2.0 * math.pi / segments)  # of a unit-radius 32-gon
-        volume = area * (0.04 ** 2 * 0.10 - 0.035 ** 2 * 0.09)
-        floor_fill = 0.01 * volume / (area * 0.035 ** 2 / 4.0)
-        self.assertAlmostEqual(0.0, mug_position.z, delta=CONTACT_SLOP)
-        self.assertGreater(ball.z, 0.02 - CONTACT_SLOP)
-        self.assertLess(ball.z, 0.02 + floor_fill)
-        rospy.loginfo('ball at z = %.5f m on the cavity floor (0.02 m, fill bound %.5f m)',
-                      ball.z, floor_fill)
-        self.assertLess(math.hypot(ball.x - mug_position.x, ball.y - mug_position.y),
-                        0.035 - 0.01 + 1e-6)
-        for name in ('mug', 'mug_again', 'marble'):
-            self.delete(name)
+        volume = area * (0.04 ** 2 * 0.10 - inner ** 2 * (0.10 - floor))
+        floor_fill = 0.01 * volume / (area * inner ** 2 / 4.0)
+        for mug_name in (name, name + '_again'):
+            mug_position = self.state(mug_name).pose.position
+            ball = self.state(mug_name + '_marble').pose.position
+            self.assertAlmostEqual(0.0, mug_position.z, delta=CONTACT_SLOP)
+            self.assertGreater(ball.z, floor + 0.01 - CONTACT_SLOP)
+            self.assertLess(ball.z, floor + 0.01 + floor_fill)
+            rospy.loginfo('ball in %s at z = %.5f m on the cavity floor (%.3f m, fill bound %.5f m)',
+                          mug_name, ball.z, floor + 0.01, floor_fill)
+            self.assertLess(math.hypot(ball.x - mug_position.x, ball.y - mug_position.y),
+                            inner - 0.01 + 1e-6)
+        for mug_name in (name, name + '_again'):
+            self.delete(mug_name)
+            self.delete(mug_name + '_marble')
+
+    def test_mug_holds_a_ball_and_its_second_spawn_is_fast(self):
+        # Walls 5 mm thick, a 1 cm floor.
+        self.check_mug_holds_a_ball('mug', inner=0.035, floor=0.01, x=0.0)
+
+    def test_thin_walled_mug_holds_a_ball(self):
+        # Walls 4 mm thick, a 5 mm floor: volume 0.23 of its hull's.
+        self.check_mug_holds_a_ball('mug_thin', inner=0.036, floor=0.005, x=3.0)
 
     def test_l_bracket_straddles_a_box_on_its_two_feet(self):
         # The L's profile (x, z) is extreme along (1, 1) at its legs' inner

@@ -4,9 +4,11 @@
 // Convex Decomposition", Game Engine Gems 3, 2016, ch. 11): the mesh is
 // voxelized with its interior filled, then cut recursively by axis-aligned
 // planes chosen to minimise the pieces' concavity plus a balance term, until
-// every piece is nearly convex or the piece budget is spent; adjacent pieces
-// whose joint hull adds little volume are merged. docs/design.md gives the
-// equations. ROS-free; runs in the mesh helper process on untrusted meshes.
+// every piece is nearly convex or the piece budget is spent; then pieces
+// whose hulls take in empty space farther than one wall thickness from the
+// mesh (a cup's cavity) are cut until none does; adjacent pieces whose joint
+// hull adds little volume and no such space are merged. docs/design.md
+// gives the equations. ROS-free; runs in the mesh helper process on untrusted meshes.
 #ifndef RIGID_BODY_SIM_IO_CONVEX_DECOMPOSITION_H_
 #define RIGID_BODY_SIM_IO_CONVEX_DECOMPOSITION_H_
 
@@ -20,11 +22,20 @@
 
 namespace rigid_body_sim::io {
 
+// Pieces at most when a cavity needs them: past max_pieces, a piece whose
+// hull takes in empty space farther than one wall thickness from the mesh
+// is still cut, up to this many pieces (the helper's reply holds at most
+// kMaxPieces = 64).
+inline constexpr int kMaxCavityPieces = 64;
+
 struct DecompositionOptions {
-  // Count, [1000, 4e6]: voxels in the mesh's bounding box. They set the
-  // candidate cut planes (one per voxel layer) and the balance term.
+  // Count, [1000, 4e6]: voxels in the mesh's bounding box at least. They
+  // set the candidate cut planes (one per voxel layer) and the balance
+  // term. A mesh with thin walls gets more, up to 4e6, so that its wall
+  // thickness spans at least 2.5 voxels.
   int voxel_count = 100000;
-  // Count, [1, 64]: pieces at most.
+  // Count, [1, 64]: pieces at most that the concavity rule makes; a cavity
+  // may grow them to kMaxCavityPieces.
   int max_pieces = 32;
   // Dimensionless, (0, 1]: a piece whose hull volume exceeds its own volume
   // by more than this fraction of the mesh volume is cut again.
