@@ -28,8 +28,10 @@ constexpr std::size_t kSearchPoints = 256;
 // The grid's voxels at most when thin walls refine it (the voxel_count
 // option's own upper bound).
 constexpr double kMaxGridVoxels = 4e6;
-// Far voxels at most that a rough evaluation tests.
-constexpr std::size_t kSearchFar = 4096;
+// Far voxels at most that a rough evaluation tests, and that a full one
+// estimates its count from.
+constexpr std::size_t kSearchFar = 16384;
+constexpr std::size_t kEstimateFar = 65536;
 // Weight of the far volume a candidate cut's halves still cover, in the
 // energy of a piece that covers far voxels: above the concavity's own weight
 // (which counts that volume once), so such a piece is cut to open the
@@ -110,12 +112,22 @@ class Decomposer {
     const double s = grid_.size();
     if (thickness_ > 0.0) grid_.MarkFar(std::max(thickness_ - 0.5 * std::sqrt(3.0) * s, 0.5 * s));
     far_stride_ = std::max<int>(1, static_cast<int>(grid_.FarCount() / kSearchFar));
+    full_stride_ = std::max<int>(1, static_cast<int>(grid_.FarCount() / kEstimateFar));
   }
 
-  // Cuts the most concave piece while the pieces number under max_pieces,
-  // then the one that covers the most far voxels while they number under
-  // kMaxCavityPieces; merges last.
-  std::vector<Piece> Run() {
+  // How a cut is ranked by the cavity its two halves still cover: by their
+  // sum, or by their sum plus half the larger. The first leaves as little
+  // covered as one cut can; the second also splits what is covered into
+  // halves, which a ring (whose every single cut leaves its cavity covered)
+  // needs before a second cut can open it. Neither wins on every part.
+  enum class CavityRule { kSum, kSumAndLarger };
+
+  // Cuts the piece that covers the most far voxels while the pieces number
+  // under kMaxCavityPieces, then the most concave one while they number
+  // under max_pieces; merges last. The cavity goes first: concavity cuts
+  // made before it would spend the budget on slabs that each span it.
+  std::vector<Piece> Run(CavityRule rule) {
+    cavity_rule_ = rule;
     std::vector<Piece> pieces = {Evaluate(grid_.Whole(), all_triangles_)};
     const double most = options_.max_concavity * volume_;
     const auto worst_by = [&pieces](auto measure, double above) {
@@ -131,11 +143,11 @@ class Decomposer {
     for (;;) {
       const int count = static_cast<int>(pieces.size());
       int worst = -1;
-      if (count < options_.max_pieces) {
-        worst = worst_by([](const Piece& piece) { return piece.concavity; }, most);
-      }
       if (worst < 0 && count < kMaxCavityPieces) {
         worst = worst_by([](const Piece& piece) { return double(piece.bridged); }, 0.0);
+      }
+      if (worst < 0 && count < options_.max_pieces) {
+        worst = worst_by([](const Piece& piece) { return piece.concavity; }, most);
       }
       if (worst < 0) break;
       std::optional<std::pair<Piece, Piece>> halves = BestCut(pieces[worst]);
@@ -151,6 +163,11 @@ class Decomposer {
   }
 
  private:
+  double CavityTerm(int left, int right) const {
+    const double sum = double(left) + right;
+    return cavity_rule_ == CavityRule::kSum ? sum : sum + 0.5 * std::max(left, right);
+  }
+
   // +1 for a mesh wound outward (positive signed volume), else -1.
   static double Orientation(const TriangleMesh& mesh) {
     double six_volume = 0.0;
@@ -309,19 +326,26 @@ class Decomposer {
     }
     piece.volume = orientation_ * SignedVolume(lower, upper, triangles);
     HullOptions hull_options = options_.hull;
+    Result<ConvexPolyhedron> hull = Result<ConvexPolyhedron>::Error("");
     if (rough && points.size() > kSearchPoints) {
       const std::size_t stride = (points.size() + kSearchPoints - 1) / kSearchPoints;
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < points.size(); i += stride) points[kept++] = points[i];
-      points.resize(kept);
+      std::vector<Vec3> sample;
+      for (std::size_t i = 0; i < points.size(); i += stride) sample.push_back(points[i]);
+      hull_options.max_vertices = static_cast<int>(kSearchPoints);
+      hull = ComputeConvexHull(sample, hull_options);
     }
-    if (rough) hull_options.max_vertices = static_cast<int>(kSearchPoints);
-    Result<ConvexPolyhedron> hull = ComputeConvexHull(points, hull_options);
+    // A sample can be flat where the part is not (a slab one voxel thick):
+    // then the part's own points decide, or a flat sample would rank the
+    // cut that makes it as free of concavity.
+    if (!hull.ok()) hull = ComputeConvexHull(points, hull_options);
     if (hull.ok()) {
       piece.hull_volume = HullVolume(*hull);
       piece.hull = std::move(hull).value();
       piece.concavity = std::max(0.0, piece.hull_volume - piece.volume);
-      piece.bridged = grid_.FarInside(*piece.hull, cell, kAll, rough ? far_stride_ : 1);
+      // Full evaluations estimate from more far voxels, and look at every
+      // one when the estimate is none, so a piece that covers any is cut.
+      piece.bridged = grid_.FarInside(*piece.hull, cell, kAll, rough ? far_stride_ : full_stride_);
+      if (!rough && piece.bridged == 0) piece.bridged = grid_.FarInside(*piece.hull, cell, 1);
     }
     return piece;
   }
@@ -350,8 +374,9 @@ class Decomposer {
       const double energy =
           (l.concavity + r.concavity) / volume_ +
           options_.balance_weight * voxel_volume * std::abs(left_voxels - right_voxels) / volume_ +
-          (piece.bridged > 0 ? kBridgeWeight * voxel_volume * (l.bridged + r.bridged) / volume_
-                             : 0.0);
+          (piece.bridged > 0
+               ? kBridgeWeight * voxel_volume * CavityTerm(l.bridged, r.bridged) / volume_
+               : 0.0);
       if (energy < best_energy) {
         best_energy = energy;
         best_axis = axis;
@@ -461,6 +486,8 @@ class Decomposer {
   double orientation_;  // -1 for a mesh wound inside out
   double thickness_;    // m, WallThickness; 0 when unknown
   VoxelGrid grid_;
+  CavityRule cavity_rule_ = CavityRule::kSum;
+  int full_stride_ = 1;                        // of the far voxels a full evaluation estimates from
   int far_stride_ = 1;                         // of the far voxels a rough evaluation tests
   std::vector<std::pair<Vec3, Vec3>> bounds_;  // per triangle
   std::vector<int> all_triangles_;             // 0, 1, ..., triangle count - 1
@@ -499,8 +526,24 @@ Result<std::vector<ConvexPolyhedron>> DecomposeConvex(const TriangleMesh& mesh,
   // Closed, finite, indices in range and of positive volume, or a message.
   Result<physics::MassProperties> mass = physics::TriangleMeshMassProperties(1.0, mesh);
   if (!mass.ok()) return Out::Error("convex decomposition needs a closed mesh: " + mass.message());
+  // The second rule runs only when the first leaves a cavity covered, and
+  // the pieces that cover the least (then the fewer) are kept.
+  Decomposer decomposer(mesh, options, mass->mass);
+  std::vector<Decomposer::Piece> pieces = decomposer.Run(Decomposer::CavityRule::kSum);
+  const auto covered = [](const std::vector<Decomposer::Piece>& list) {
+    long total = 0;
+    for (const Decomposer::Piece& piece : list) total += piece.bridged;
+    return total;
+  };
+  if (covered(pieces) > 0) {
+    std::vector<Decomposer::Piece> other = decomposer.Run(Decomposer::CavityRule::kSumAndLarger);
+    if (covered(other) < covered(pieces) ||
+        (covered(other) == covered(pieces) && other.size() < pieces.size())) {
+      pieces = std::move(other);
+    }
+  }
   std::vector<ConvexPolyhedron> hulls;
-  for (Decomposer::Piece& piece : Decomposer(mesh, options, mass->mass).Run()) {
+  for (Decomposer::Piece& piece : pieces) {
     if (piece.hull) hulls.push_back(std::move(*piece.hull));
   }
   if (hulls.empty()) return Out::Error("convex decomposition found no piece of positive volume");

@@ -3,11 +3,12 @@
 // After V-HACD (Mamou, Lengyel, Peters, "Volumetric Hierarchical Approximate
 // Convex Decomposition", Game Engine Gems 3, 2016, ch. 11): the mesh is
 // voxelized with its interior filled, then cut recursively by axis-aligned
-// planes chosen to minimise the pieces' concavity plus a balance term, until
-// every piece is nearly convex or the piece budget is spent; then pieces
-// whose hulls take in empty space farther than one wall thickness from the
-// mesh (a cup's cavity) are cut until none does; adjacent pieces whose joint
-// hull adds little volume and no such space are merged. docs/design.md
+// planes: first pieces whose hulls take in empty space farther than one wall
+// thickness from the mesh (a cup's cavity), until none does, then pieces
+// whose hulls exceed them by much (concavity), each by the plane that
+// minimises the halves' concavity, cavity and a balance term, until the
+// piece budget is spent; adjacent pieces whose joint hull adds little volume
+// and no such space are merged. docs/design.md
 // gives the equations. ROS-free; runs in the mesh helper process on untrusted meshes.
 #ifndef RIGID_BODY_SIM_IO_CONVEX_DECOMPOSITION_H_
 #define RIGID_BODY_SIM_IO_CONVEX_DECOMPOSITION_H_

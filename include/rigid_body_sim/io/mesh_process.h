@@ -36,7 +36,7 @@ inline constexpr std::uint64_t kDefaultMaxMeshTriangles = std::uint64_t{1} << 22
 struct MeshProcessLimits {
   std::string helper_path;                                  // the helper executable
   std::uint64_t memory_bytes = std::uint64_t{1} << 30;      // RLIMIT_AS of the helper
-  double cpu_seconds = 10.0;                                // RLIMIT_CPU; wall time 2x + 1 s
+  double cpu_seconds = 30.0;                                // RLIMIT_CPU; wall time 2x + 1 s
   std::uint64_t max_file_bytes = std::uint64_t{256} << 20;  // larger files are not opened
   // Most triangles of a static mesh (one that collides as its triangles),
   // in [1, CollisionMesh::kMaxTriangles].

@@ -78,7 +78,7 @@ struct NodeOptions {
   int max_file_bytes = 256 << 20;  // ~max_file_bytes: URDF and mesh files, bytes, >= 1
   // Limits of the mesh helper process (io/mesh_process.h).
   int mesh_memory_limit = 1 << 30;  // ~mesh_memory_limit: bytes of address space, >= 2^24
-  double mesh_cpu_limit = 10.0;     // ~mesh_cpu_limit: s of CPU, (0, 3600]
+  double mesh_cpu_limit = 30.0;     // ~mesh_cpu_limit: s of CPU, (0, 3600]
   // ~max_mesh_triangles: count, [1, 2^24]: triangles of one static mesh
   // (io::kDefaultMaxMeshTriangles, 4 Mi by default).
   int max_mesh_triangles = static_cast<int>(io::kDefaultMaxMeshTriangles);
