@@ -61,7 +61,9 @@ class CollisionMesh {
   // The box of every vertex (m, mesh frame): the tree's bounds.
   const Vec3& lower() const;
   const Vec3& upper() const;
-  // The largest distance of a vertex from `center` (m).
+  // The largest distance of a vertex from `center` (m). About the origin it
+  // is kept from the build, since the time-of-impact search asks for it on
+  // every pair with the mesh and a terrain has many vertices.
   double BoundingRadius(const Vec3& center) const;
 
   // Appends to `out` the triangles whose boxes overlap the closed box
@@ -79,6 +81,7 @@ class CollisionMesh {
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
   std::shared_ptr<const WideBoxTree> tree_;
+  double radius_about_origin_ = 0.0;  // m
 };
 
 }  // namespace rigid_body_sim::physics

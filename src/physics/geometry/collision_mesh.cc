@@ -202,12 +202,17 @@ void CollisionMesh::BuildTree() {
   std::vector<Triangle> sorted(triangles_.size());
   for (std::size_t i = 0; i < sorted.size(); ++i) sorted[i] = triangles_[order[i]];
   triangles_.swap(sorted);
+  double radius_squared = 0.0;
+  for (const Vec3& vertex : vertices_)
+    radius_squared = std::max(radius_squared, vertex.squaredNorm());
+  radius_about_origin_ = std::sqrt(radius_squared);
 }
 
 const Vec3& CollisionMesh::lower() const { return tree_->bounds().min; }
 const Vec3& CollisionMesh::upper() const { return tree_->bounds().max; }
 
 double CollisionMesh::BoundingRadius(const Vec3& center) const {
+  if (center.isZero(0.0)) return radius_about_origin_;
   double radius_squared = 0.0;
   for (const Vec3& vertex : vertices_) {
     radius_squared = std::max(radius_squared, (vertex - center).squaredNorm());
