@@ -11,6 +11,9 @@ The meshes come from test/data/make_decomposition_meshes.py.
 
 import math
 import os
+import random
+import struct
+import tempfile
 import time
 import unittest
 
@@ -48,6 +51,74 @@ def pose(x, y, z, pitch=0.0):
     return Pose(Point(x, y, z), Quaternion(0.0, math.sin(pitch / 2), 0.0, math.cos(pitch / 2)))
 
 
+# The terrain of test_boxes_rest_on_a_terrain: a 10 m square of 224 x 224
+# cells (100,352 triangles), each cell split along its (i, j)-(i+1, j+1)
+# diagonal, over z = TERRAIN_BASE + A (sin(2 pi x / 2.5) + sin(2 pi y / 1.6)),
+# hills of +-5 cm, its surface about 0.48 m above the ground plane.
+TERRAIN_CELLS = 224
+TERRAIN_SIDE = 10.0  # m
+TERRAIN_BASE = 0.48  # m
+TERRAIN_AMPLITUDE = 0.025  # m
+
+
+def hills(x, y):
+    return TERRAIN_BASE + TERRAIN_AMPLITUDE * (math.sin(2.0 * math.pi * x / 2.5) +
+                                               math.sin(2.0 * math.pi * y / 1.6))
+
+
+def terrain_height(x, y):
+    """The triangulated surface at (x, y) (terrain frame): the linear
+    interpolant of hills over the cell's triangle."""
+    cell = TERRAIN_SIDE / TERRAIN_CELLS
+    u = (x + 0.5 * TERRAIN_SIDE) / cell
+    v = (y + 0.5 * TERRAIN_SIDE) / cell
+    i = min(max(int(math.floor(u)), 0), TERRAIN_CELLS - 1)
+    j = min(max(int(math.floor(v)), 0), TERRAIN_CELLS - 1)
+    fu, fv = u - i, v - j
+    x0, y0 = -0.5 * TERRAIN_SIDE + i * cell, -0.5 * TERRAIN_SIDE + j * cell
+    h00, h11 = hills(x0, y0), hills(x0 + cell, y0 + cell)
+    if fu >= fv:  # below the diagonal: (i, j), (i+1, j), (i+1, j+1)
+        h10 = hills(x0 + cell, y0)
+        return h00 + fu * (h10 - h00) + fv * (h11 - h10)
+    h01 = hills(x0, y0 + cell)  # above it: (i, j), (i+1, j+1), (i, j+1)
+    return h00 + fv * (h01 - h00) + fu * (h11 - h01)
+
+
+def write_terrain_stl(path):
+    n = TERRAIN_CELLS
+    cell = TERRAIN_SIDE / n
+    corner = [[(-0.5 * TERRAIN_SIDE + i * cell, -0.5 * TERRAIN_SIDE + j * cell,
+                hills(-0.5 * TERRAIN_SIDE + i * cell, -0.5 * TERRAIN_SIDE + j * cell))
+               for j in range(n + 1)] for i in range(n + 1)]
+    with open(path, 'wb') as f:
+        f.write(b'terrain of concave_test.py'.ljust(80, b' '))
+        f.write(struct.pack('<I', 2 * n * n))
+        for i in range(n):
+            for j in range(n):
+                a, b, c, d = corner[i][j], corner[i + 1][j], corner[i + 1][j + 1], corner[i][j + 1]
+                for tri in ((a, b, c), (a, c, d)):  # counter-clockwise from above
+                    f.write(struct.pack('<3f', 0.0, 0.0, 1.0))
+                    for vertex in tri:
+                        f.write(struct.pack('<3f', *vertex))
+                    f.write(struct.pack('<H', 0))
+
+
+def random_quaternion(rng):
+    """Uniform on the sphere of unit quaternions (Shoemake 1992)."""
+    u1, u2, u3 = rng.random(), rng.random(), rng.random()
+    a, b = math.sqrt(1.0 - u1), math.sqrt(u1)
+    return Quaternion(a * math.sin(2 * math.pi * u2), a * math.cos(2 * math.pi * u2),
+                      b * math.sin(2 * math.pi * u3), b * math.cos(2 * math.pi * u3))
+
+
+def rotate(q, v):
+    """v turned by the unit quaternion q."""
+    w, x, y, z = q.w, q.x, q.y, q.z
+    t = (2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0]))
+    return (v[0] + w * t[0] + y * t[2] - z * t[1], v[1] + w * t[1] + z * t[0] - x * t[2],
+            v[2] + w * t[2] + x * t[1] - y * t[0])
+
+
 class ConcaveTest(unittest.TestCase):
 
     @classmethod
@@ -62,9 +133,10 @@ class ConcaveTest(unittest.TestCase):
         self.delete = service('delete', Delete)
         self.time_step = service('get_physics', GetPhysics)().time_step
 
-    def spawn(self, name, urdf='', urdf_path='', at=None, twist=None, is_static=False):
+    def spawn(self, name, urdf='', urdf_path='', at=None, twist=None, is_static=False,
+              friction=-1.0):
         request = SpawnRequest(name=name, urdf=urdf, urdf_path=urdf_path, pose=at or pose(0, 0, 0),
-                               is_static=is_static, friction=-1.0, restitution=-1.0)
+                               is_static=is_static, friction=friction, restitution=-1.0)
         if twist is not None:
             request.twist = twist
         result = self.spawn_service(request)
@@ -170,6 +242,66 @@ class ConcaveTest(unittest.TestCase):
         rospy.loginfo('crate in the bin at z = %.5f m (analytic 0.055 m)', crate_z)
         self.assertAlmostEqual(0.005 + 0.05, crate_z, delta=0.001)
         for name in ('bin', 'crate'):
+            self.delete(name)
+
+    def test_boxes_rest_on_a_terrain(self):
+        # 300 boxes of 10 cm and 0.5 kg (friction 0.6) dropped from 5 to 50 cm
+        # (their centres 9 cm more, above the reach of any corner) over a
+        # 100,352-triangle terrain, in random orientations: after 5 s
+        # every one rests on the surface. The lowest corner of each lies on
+        # the triangle under it to within 5 mm, and none is below it by more
+        # than the contact slop. A box that went through the terrain would
+        # end on the ground plane, 0.48 m down.
+        terrain_x, terrain_y = 30.0, 30.0
+        with tempfile.TemporaryDirectory() as directory:
+            path = os.path.join(directory, 'terrain.stl')
+            write_terrain_stl(path)
+            self.spawn('terrain', urdf=mesh_urdf('terrain', path),
+                       at=pose(terrain_x, terrain_y, 0.0), is_static=True)
+        inertia = 0.5 * 0.1 ** 2 / 6.0
+        box = ('<robot name="box"><link name="body"><inertial><mass value="0.5"/>'
+               '<inertia ixx="%g" iyy="%g" izz="%g" ixy="0" ixz="0" iyz="0"/></inertial>'
+               '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+               '</link></robot>' % (inertia, inertia, inertia))
+        # One box in each of 300 of the 18 x 18 cells of 0.52 m, placed at
+        # random within 0.16 m of the cell's centre, so no box lands on
+        # another (which would rest a box's height above the terrain).
+        rng = random.Random(39)
+        names = []
+        cell = 9.36 / 18
+        for k, index in enumerate(sorted(rng.sample(range(18 * 18), 300))):
+            x = -4.68 + (index // 18 + 0.5) * cell + rng.uniform(-0.16, 0.16)
+            y = -4.68 + (index % 18 + 0.5) * cell + rng.uniform(-0.16, 0.16)
+            z = terrain_height(x, y) + 0.09 + rng.uniform(0.05, 0.5)
+            at = Pose(Point(terrain_x + x, terrain_y + y, z), random_quaternion(rng))
+            names.append('terrain_box_%d' % k)
+            self.spawn(names[-1], urdf=box, at=at, friction=0.6)
+        self.run_for(5.0)
+        corners = [(sx * 0.05, sy * 0.05, sz * 0.05)
+                   for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+        deepest, highest, fastest, fastest_turn = math.inf, -math.inf, 0.0, 0.0
+        for name in names:
+            state = self.state(name)
+            p, q = state.pose.position, state.pose.orientation
+            gaps = []
+            for corner in corners:
+                c = rotate(q, corner)
+                cx, cy, cz = p.x + c[0] - terrain_x, p.y + c[1] - terrain_y, p.z + c[2]
+                gaps.append(cz - terrain_height(cx, cy))
+            lowest = min(gaps)
+            deepest, highest = min(deepest, lowest), max(highest, lowest)
+            v, w = state.twist.linear, state.twist.angular
+            fastest = max(fastest, math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2))
+            fastest_turn = max(fastest_turn, math.sqrt(w.x ** 2 + w.y ** 2 + w.z ** 2))
+            self.assertGreater(lowest, -CONTACT_SLOP, name)
+            self.assertLess(lowest, 0.005, name)
+        rospy.loginfo('300 boxes on the terrain after 5 s: lowest corners %.5f to %.5f m from the '
+                      'surface, fastest %.2e m/s, %.2e rad/s', deepest, highest, fastest,
+                      fastest_turn)
+        # At rest: every box asleep, its velocity exactly zero.
+        self.assertEqual(0.0, fastest)
+        self.assertEqual(0.0, fastest_turn)
+        for name in names + ['terrain']:
             self.delete(name)
 
     def test_ball_rolls_under_the_mesh_table(self):

@@ -100,8 +100,8 @@ class SensorsTest(unittest.TestCase):
 
     def drive(self, name, namespace, odoms):
         """Drives the model at 0.1 m/s by cmd_vel for 5 s (1200 steps), and
-        returns where it ends, the distance it travelled and its last
-        odometry."""
+        returns where it ends, the distance it travelled, its last odometry
+        and the simulated time at the end (s)."""
         start = self.get_state(name).pose.position
         command = rospy.Publisher(namespace + '/cmd_vel', Twist, queue_size=1, latch=True)
         twist = Twist()
@@ -109,10 +109,10 @@ class SensorsTest(unittest.TestCase):
         command.publish(twist)
         time.sleep(1.0)
         first = len(odoms.wait(1))
-        self.step(1200)
+        sim_time = self.step(1200).sim_time
         end = self.get_state(name).pose.position
         travelled = math.hypot(end.x - start.x, end.y - start.y)
-        return end, travelled, odoms.wait(first + 150)[-1]
+        return end, travelled, odoms.wait(first + 150)[-1], sim_time
 
     def test_laser_ranges_in_a_known_room(self):
         # The post's laser is 0.5 m up at the origin; beams along +x, +y,
@@ -209,7 +209,7 @@ class SensorsTest(unittest.TestCase):
         self.spawn('diff_bot', urdf_path=self.data + 'diff_bot.urdf', xyz=(-3, -3, 0.05))
         self.assertTrue(odoms.connect() and scans.connect())
         self.step(120)  # settle on its wheels
-        _, travelled, odom = self.drive('diff_bot', SIM + 'diff_bot', odoms)
+        _, travelled, odom, _ = self.drive('diff_bot', SIM + 'diff_bot', odoms)
         self.assertAlmostEqual(0.5, travelled, delta=0.03 * 0.5)
         odom_travelled = math.hypot(odom.pose.pose.position.x, odom.pose.pose.position.y)
         self.assertAlmostEqual(travelled, odom_travelled, delta=0.02 * travelled)
@@ -239,7 +239,7 @@ class SensorsTest(unittest.TestCase):
         self.step(240)  # settle on its wheels and caster
         imu = imus.wait(200)[-1]
         self.assertAlmostEqual(G, imu.linear_acceleration.z, delta=1e-3)
-        end, travelled, odom = self.drive('rover_test', '/rover_test', odoms)
+        end, travelled, odom, sim_time = self.drive('rover_test', '/rover_test', odoms)
         self.assertAlmostEqual(0.5, travelled, delta=0.03 * 0.5)
         # The world source: odom is the world frame, so odom's pose is the
         # footprint's true pose.
@@ -252,9 +252,15 @@ class SensorsTest(unittest.TestCase):
         self.assertEqual('rover_test/base_scan', scan.header.frame_id)
         # One tree: world -> rover_test/odom -> rover_test/base_footprint puts
         # the footprint where the node's own state says.
+        # The transform of the drive's last step: the listener receives tf
+        # after the step service answers, so the latest it holds may be an
+        # earlier step's. Once it holds one within a microsecond of the end
+        # (steps are 4 ms apart; the stamp's nanoseconds may round either
+        # way), its latest is the last step's.
         deadline = time.time() + 10.0
         frame = 'rover_test/base_footprint'
-        while time.time() < deadline and not buffer.can_transform('world', frame, rospy.Time(0)):
+        last_step = rospy.Time.from_sec(sim_time - 1e-6)
+        while time.time() < deadline and not buffer.can_transform('world', frame, last_step):
             time.sleep(0.05)
         transform = buffer.lookup_transform('world', frame, rospy.Time(0)).transform
         self.assertAlmostEqual(end.x, transform.translation.x, delta=1e-3)
