@@ -105,10 +105,10 @@ class Decomposer {
       bounds_.push_back({a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)});
       all_triangles_.push_back(static_cast<int>(all_triangles_.size()));
     }
-    // A point farther than one wall thickness T from the surface lies in a
-    // voxel whose centre is farther than T - sqrt(3) s from every occupied
-    // voxel's centre (half a diagonal s sqrt(3) / 2 from the point to its
-    // centre, and as much from an occupied centre to the surface in it).
+    // The surface lies within half a voxel diagonal, s sqrt(3) / 2, of an
+    // occupied voxel's centre, so a centre farther than one wall thickness T
+    // from the mesh is farther than T - s sqrt(3) / 2 from every occupied
+    // centre: those are marked far.
     const double s = grid_.size();
     if (thickness_ > 0.0) grid_.MarkFar(std::max(thickness_ - 0.5 * std::sqrt(3.0) * s, 0.5 * s));
     far_stride_ = std::max<int>(1, static_cast<int>(grid_.FarCount() / kSearchFar));
@@ -143,7 +143,7 @@ class Decomposer {
     for (;;) {
       const int count = static_cast<int>(pieces.size());
       int worst = -1;
-      if (worst < 0 && count < kMaxCavityPieces) {
+      if (count < kMaxCavityPieces) {
         worst = worst_by([](const Piece& piece) { return double(piece.bridged); }, 0.0);
       }
       if (worst < 0 && count < options_.max_pieces) {
@@ -177,8 +177,8 @@ class Decomposer {
     return six_volume < 0.0 ? -1.0 : 1.0;
   }
 
-  // Voxels enough for an edge of at most a third of the wall thickness, so a
-  // wall is at least three voxels thick, and at least `voxel_count`; at most
+  // Voxels enough for an edge of at most the wall thickness / 2.5, so a
+  // wall spans at least 2.5 voxels, and at least `voxel_count`; at most
   // kMaxGridVoxels.
   static int GridVoxels(const TriangleMesh& mesh, int voxel_count, double thickness) {
     if (!(thickness > 0.0)) return voxel_count;
