@@ -182,12 +182,7 @@ class Decomposer {
   // kMaxGridVoxels.
   static int GridVoxels(const TriangleMesh& mesh, int voxel_count, double thickness) {
     if (!(thickness > 0.0)) return voxel_count;
-    Vec3 lower = mesh.vertices.front();
-    Vec3 upper = lower;
-    for (const Vec3& vertex : mesh.vertices) {
-      lower = lower.cwiseMin(vertex);
-      upper = upper.cwiseMax(vertex);
-    }
+    const auto [lower, upper] = MeshBounds(mesh);
     const Vec3 cells = (upper - lower) / (thickness / 2.5);
     const double needed = std::max(cells.prod(), cells.maxCoeff() * cells.maxCoeff());
     return static_cast<int>(std::clamp(needed, double(voxel_count), double(kMaxGridVoxels)));

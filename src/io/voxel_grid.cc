@@ -17,9 +17,9 @@ constexpr int kThicknessRays = 256;
 // place: d(p) = min_q ((p - q)^2 + f(q)), by the lower envelope of the
 // parabolas rooted at the finite samples (Felzenszwalb, Huttenlocher,
 // "Distance Transforms of Sampled Functions", Theory of Computing 8, 2012,
-// section 2.1). `roots` and `bounds` are scratch of n and n + 1.
+// section 2.1). `roots`, `bounds` and `line` are scratch of n, n + 1 and n.
 void SquaredDistanceLine(float* f, int n, std::ptrdiff_t stride, std::vector<int>* roots,
-                         std::vector<double>* bounds) {
+                         std::vector<double>* bounds, std::vector<float>* line) {
   const double inf = std::numeric_limits<double>::infinity();
   int* v = roots->data();
   double* z = bounds->data();
@@ -48,12 +48,12 @@ void SquaredDistanceLine(float* f, int n, std::ptrdiff_t stride, std::vector<int
     z[k + 1] = inf;
   }
   if (k < 0) return;  // no finite sample: every distance stays infinite
-  std::vector<float> line(static_cast<std::size_t>(n));
+  float* envelope = line->data();
   for (int q = 0, j = 0; q < n; ++q) {
     while (z[j + 1] < q) ++j;
-    line[q] = static_cast<float>(double(q - v[j]) * (q - v[j]) + at(v[j]));
+    envelope[q] = static_cast<float>(double(q - v[j]) * (q - v[j]) + at(v[j]));
   }
-  for (int q = 0; q < n; ++q) f[q * stride] = line[q];
+  for (int q = 0; q < n; ++q) f[q * stride] = envelope[q];
 }
 
 // Moller-Trumbore ray-triangle intersection (Moller, Trumbore, "Fast,
@@ -89,13 +89,18 @@ std::optional<double> VerticalCrossing(const Vec3& a, const Vec3& b, const Vec3&
   return w_a * a.z() + w_b * b.z() + w_c * c.z();
 }
 
-VoxelGrid::VoxelGrid(const TriangleMesh& mesh, int voxel_count) {
+std::pair<Vec3, Vec3> MeshBounds(const TriangleMesh& mesh) {
   Vec3 lower = mesh.vertices.front();
   Vec3 upper = lower;
   for (const Vec3& vertex : mesh.vertices) {
     lower = lower.cwiseMin(vertex);
     upper = upper.cwiseMax(vertex);
   }
+  return {lower, upper};
+}
+
+VoxelGrid::VoxelGrid(const TriangleMesh& mesh, int voxel_count) {
+  const auto [lower, upper] = MeshBounds(mesh);
   const Vec3 extent = upper - lower;
   const double count = voxel_count;
   size_ = std::max(std::cbrt(extent.prod() / count), extent.maxCoeff() / std::sqrt(count));
@@ -221,6 +226,7 @@ void VoxelGrid::MarkFar(double gap) {
   const std::ptrdiff_t strides[3] = {static_cast<std::ptrdiff_t>(n[1]) * n[2], n[2], 1};
   std::vector<int> roots(static_cast<std::size_t>(cells_.maxCoeff()));
   std::vector<double> bounds(roots.size() + 1);
+  std::vector<float> scratch(roots.size());
   // Separable: one pass of lines along each axis in turn.
   for (int axis = 0; axis < 3; ++axis) {
     const int a = (axis + 1) % 3;
@@ -228,7 +234,7 @@ void VoxelGrid::MarkFar(double gap) {
     for (int i = 0; i < n[a]; ++i) {
       for (int j = 0; j < n[b]; ++j) {
         float* line = distance.data() + i * strides[a] + j * strides[b];
-        SquaredDistanceLine(line, n[axis], strides[axis], &roots, &bounds);
+        SquaredDistanceLine(line, n[axis], strides[axis], &roots, &bounds, &scratch);
       }
     }
   }

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "rigid_body_sim/physics/convex_polyhedron.h"
@@ -84,6 +85,9 @@ class VoxelGrid {
   std::vector<std::uint32_t> far_;
   std::vector<std::size_t> far_start_;
 };
+
+// The box of the mesh's vertices (m): lower and upper corners.
+std::pair<physics::Vec3, physics::Vec3> MeshBounds(const physics::TriangleMesh& mesh);
 
 // The wall thickness of a closed mesh (m): its shape diameter, the distance
 // from a surface point along the inward normal to the surface's other side,
