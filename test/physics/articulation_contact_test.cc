@@ -306,8 +306,10 @@ LinkDef BoxLink(double mass, const Vec3& size, double friction) {
 // A parallel gripper on a lift: two fingers squeeze a 0.2 kg box with 20 N
 // each (mu = 1), the lift raises it 0.2 m in 1 s and holds it 5 s. The box
 // rises with the hand and slips less than 5 mm relative to it.
-TEST(ArticulationContactTest, GripperLiftsABoxWithoutLettingItSlip) {
-  World world = MakeWorld();
+// Both solvers: the rigid box's contacts are the solver's, the fingers'
+// the articulations' joint-space solve.
+void LiftBoxInGripper(MotionSolverKind solver) {
+  World world = MakeWorld(solver);
   AddGround(&world, MakeMaterial(1.0, 0.0));
   BoxSpec spec;
   spec.size = Vec3(0.05, 0.05, 0.05);
@@ -353,6 +355,14 @@ TEST(ArticulationContactTest, GripperLiftsABoxWithoutLettingItSlip) {
       world.GetPose(box).translation.z() - world.GetPose(carriage).translation.z();
   EXPECT_NEAR(world.GetPose(box).translation.z(), 0.025 + 0.2, 5e-3);
   EXPECT_LT(std::abs(end_offset - start_offset), 5e-3);
+}
+
+TEST(ArticulationContactTest, GripperLiftsABoxWithoutLettingItSlip) {
+  LiftBoxInGripper(MotionSolverKind::kExact);
+}
+
+TEST(ArticulationContactTest, GripperLiftsABoxWithoutLettingItSlipUnderTheSoftStep) {
+  LiftBoxInGripper(MotionSolverKind::kSoftStep);
 }
 
 // A gripper of two fingers on prismatic joints holds a 5 cm, 0.1 kg box

@@ -51,8 +51,9 @@ inline JointDef Hinge(int child, double parent_length, double position) {
   return joint;
 }
 
-inline World MakeWorld() {
+inline World MakeWorld(MotionSolverKind solver = MotionSolverKind::kExact) {
   WorldSettings settings;
+  settings.motion_solver = solver;
   settings.time_step = kDt;
   settings.gravity = Vec3(0, 0, -kG);
   return World(settings);

@@ -146,9 +146,10 @@ std::uint64_t HashContacts(const World& world) {
   return hash.value();
 }
 
-WorldSettings WithThreads(int threads) {
+WorldSettings WithThreads(int threads, MotionSolverKind solver = MotionSolverKind::kExact) {
   WorldSettings settings;
   settings.threads = threads;
+  settings.motion_solver = solver;
   return settings;
 }
 
@@ -161,8 +162,8 @@ struct PileRun {
 
 constexpr int kSteps = 1000;
 
-PileRun RunPiles(int threads) {
-  World world(WithThreads(threads));
+PileRun RunPiles(int threads, MotionSolverKind solver = MotionSolverKind::kExact) {
+  World world(WithThreads(threads, solver));
   const std::vector<BodyId> bodies = BuildPiles(&world);
   PileRun run;
   for (int step = 0; step < kSteps; ++step) {
@@ -202,11 +203,24 @@ TEST(ThreadsTest, PileHashIsTheSameForEveryRunAndThreadCount) {
   EXPECT_EQ(two.hash, one.hash);
 }
 
+// The soft step's colours on two threads: the same hash as on one, run
+// after run (the colours share no moving body, so the split of a colour
+// among threads cannot change a bit).
+TEST(ThreadsTest, SoftStepPileHashIsTheSameForEveryRunAndThreadCount) {
+  const PileRun one = RunPiles(1, MotionSolverKind::kSoftStep);
+  const PileRun one_again = RunPiles(1, MotionSolverKind::kSoftStep);
+  const PileRun two = RunPiles(2, MotionSolverKind::kSoftStep);
+  EXPECT_LT(one.top, 0.5);
+  EXPECT_GT(one.most_solver_points, 400u);
+  EXPECT_EQ(one_again.hash, one.hash);
+  EXPECT_EQ(two.hash, one.hash);
+}
+
 // Step by step, every body's state and every contact report of a world on
-// two threads equal the single-thread reference's.
-TEST(ThreadsTest, TwoThreadsStepLikeTheReferenceEveryStep) {
-  World reference(WithThreads(1));
-  World threaded(WithThreads(2));
+// two threads equal the single-thread reference's, for either solver.
+void ExpectTwoThreadsStepLikeTheReference(MotionSolverKind solver) {
+  World reference(WithThreads(1, solver));
+  World threaded(WithThreads(2, solver));
   const std::vector<BodyId> reference_bodies = BuildPiles(&reference);
   const std::vector<BodyId> threaded_bodies = BuildPiles(&threaded);
   std::size_t most_reports = 0;
@@ -220,6 +234,14 @@ TEST(ThreadsTest, TwoThreadsStepLikeTheReferenceEveryStep) {
     most_reports = std::max(most_reports, reference.contacts().size());
   }
   EXPECT_GT(most_reports, 400u);
+}
+
+TEST(ThreadsTest, TwoThreadsStepLikeTheReferenceEveryStep) {
+  ExpectTwoThreadsStepLikeTheReference(MotionSolverKind::kExact);
+}
+
+TEST(ThreadsTest, SoftStepTwoThreadsStepLikeTheReferenceEveryStep) {
+  ExpectTwoThreadsStepLikeTheReference(MotionSolverKind::kSoftStep);
 }
 
 }  // namespace

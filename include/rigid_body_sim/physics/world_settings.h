@@ -80,7 +80,43 @@ struct SleepSettings {
 // The most threads WorldSettings::threads may ask for.
 constexpr int kMaxThreads = 256;
 
-enum class MotionSolverKind : std::uint8_t { kExact };
+// The solver of the stages from velocities to positions (docs/design.md,
+// "Two solvers"). kExact: Baraff's classification of every contact, exact
+// collision impulses with restitution, resting contact for all contacts at
+// once, and the time of impact found; the default. kSoftStep: sub-steps with
+// one relaxed iteration of soft contacts each, colour by colour on every
+// thread (Catto 2024, "Solver2D"), for big scenes that want speed first.
+enum class MotionSolverKind : std::uint8_t { kExact, kSoftStep };
+
+// The soft step's settings (MotionSolverKind::kSoftStep).
+struct SoftStepSettings {
+  // Sub-steps per step, in [1, kMaxSoftSubsteps]: each integrates the
+  // velocities, solves every contact once with its softness, integrates the
+  // positions and relaxes once.
+  int substeps = 4;
+  // Hz, > 0 and finite: the natural frequency of a contact's spring for its
+  // effective mass (twice this against a body that does not move), at most
+  // a quarter of the sub-step rate (a stiffer spring is not resolved by one
+  // iteration a sub-step; Box2D v3 caps it the same way).
+  double contact_hertz = 30.0;
+  // The contact spring's damping ratio, finite and >= 0 (1: critical).
+  double contact_damping_ratio = 10.0;
+  // In [0, 1]: the fraction by which a contact's preload (the load its
+  // spring carries at zero penetration) moves toward the load it carried,
+  // each step. A plain soft contact (0) sags g / (2 pi f)^2 per weight it
+  // carries: 0.28 mm per box at 30 Hz, centimetres under a tall stack. The
+  // preload removes that sag at rest; larger values remove it sooner, but
+  // beyond about 0.1 the tall stacks of the benchmark rock.
+  double load_tracking = 0.05;
+  // m/s, > 0: the fastest a contact's spring pushes penetrating bodies
+  // apart (it moves them; it adds no momentum that stays).
+  double max_push_velocity = 3.0;
+};
+
+// The most sub-steps SoftStepSettings::substeps may ask for.
+constexpr int kMaxSoftSubsteps = 64;
+
+Status ValidateSoftStepSettings(const SoftStepSettings& settings);
 
 struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  // m/s^2, world frame (REP 103: z up)
@@ -110,10 +146,10 @@ struct WorldSettings {
   // default) starts no thread and is the reference path.
   int threads = 1;
   // The solver of the stages from velocities to positions (the contact
-  // solve and the impacts): kExact, Baraff's classification and the exact
-  // time of impact (docs/design.md, stages 4 and 5), the only one so far.
+  // solve and the impacts); see MotionSolverKind.
   MotionSolverKind motion_solver = MotionSolverKind::kExact;
-  SolverSettings solver;  // kExact's
+  SolverSettings solver;       // kExact's; kSoftStep reads collision_velocity_threshold
+  SoftStepSettings soft_step;  // kSoftStep's
   SleepSettings sleep;
 };
 

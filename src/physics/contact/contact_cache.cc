@@ -49,6 +49,8 @@ void MatchWarmStarts(ShapePairContact* entry) {
     CachedImpulse& warm = entry->warm_start[i];
     warm.normal_impulse = entry->previous[nearest].normal_impulse;
     warm.tangent_impulse = entry->previous[nearest].tangent_impulse;
+    warm.preload = entry->previous[nearest].preload;
+    warm.approach_velocity = entry->previous[nearest].approach_velocity;
   }
 }
 

@@ -27,6 +27,12 @@ struct CachedImpulse {
   double normal_impulse = 0.0;              // N s
   std::array<double, 2> tangent_impulse{};  // N s, in the manifold's tangent basis
   Vec3 position_world = Vec3::Zero();       // m, where the point was; set in `previous`
+  // N s per step: the load the soft step's contact spring carries at its
+  // rest length (soft_contact_solver.h); the exact solver leaves it 0.
+  double preload = 0.0;
+  // m/s, < 0: the soft step saw the point closing at this speed at the end
+  // of the step, before it touched; its restitution answers it next step.
+  double approach_velocity = 0.0;
 };
 
 // What a manifold between two polyhedra needs to be carried to a nearby
@@ -40,6 +46,19 @@ struct ManifoldAnchors {
   Vec3 normal_shape = Vec3::UnitZ();                     // unit, reference shape frame
   std::array<Vec3, ContactManifold::kMaxPoints> on_a{};  // m, A's shape frame
   std::array<Vec3, ContactManifold::kMaxPoints> on_b{};  // m, B's shape frame
+};
+
+// Where a manifold's static friction holds: a material point of each body
+// (principal frames) that were together when the contact began to stick.
+// While friction holds, the solve pulls them back together, so a stack at
+// rest does not creep however many sub-steps its friction takes to settle;
+// once friction slips, the anchors start again where the contact is. The
+// soft step's (soft_contact_solver.h); the exact solver converges its
+// friction every step and needs none.
+struct FrictionAnchor {
+  bool valid = false;
+  Vec3 on_a = Vec3::Zero();  // m, A's principal frame
+  Vec3 on_b = Vec3::Zero();
 };
 
 struct ShapePairContact {
@@ -69,6 +88,7 @@ struct ShapePairContact {
   // Last step's points and their final impulses.
   std::array<CachedImpulse, ContactManifold::kMaxPoints> previous{};
   int previous_count = 0;
+  FrictionAnchor friction_anchor;
 };
 
 // Entries ahead of the one in use whose lines a walk over entries starts

@@ -47,6 +47,8 @@ struct SolverPoint {
   double normal_impulse = 0.0;              // N s, resting phase (warm-started)
   std::array<double, 2> tangent_impulse{};  // N s, resting phase (warm-started)
   double pseudo_impulse = 0.0;
+  double preload = 0.0;           // N s per step, the soft step's (CachedImpulse::preload)
+  double carried_approach = 0.0;  // m/s, likewise (CachedImpulse::approach_velocity)
   ContactType type = ContactType::kSeparating;
   FeatureId feature;
 };

@@ -23,6 +23,8 @@ std::unique_ptr<MotionSolver> MakeMotionSolver(MotionSolverKind kind, WorldImpl*
   switch (kind) {
     case MotionSolverKind::kExact:
       break;
+    case MotionSolverKind::kSoftStep:
+      return MakeSoftStepSolver(world);
   }
   return std::make_unique<ExactSolver>(world);
 }

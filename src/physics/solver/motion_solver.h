@@ -3,10 +3,9 @@
 // the integration with its impacts (stage 5). The world builds the contact
 // problem's input (broad and narrow phase, contact cache, the articulations'
 // dynamics) and orders the stages; a MotionSolver, chosen by
-// WorldSettings::motion_solver, runs these two. A second solver (a
-// sub-stepped soft one) is a second implementation, made in
-// MakeMotionSolver, and needs no change to collision, contact building or
-// articulation dynamics.
+// WorldSettings::motion_solver, runs these two: the exact solver
+// (exact_solver.cc) or the soft step (soft_step_solver.cc). Neither changes
+// collision, contact building or articulation dynamics.
 #ifndef RIGID_BODY_SIM_PHYSICS_SOLVER_MOTION_SOLVER_H_
 #define RIGID_BODY_SIM_PHYSICS_SOLVER_MOTION_SOLVER_H_
 
@@ -32,6 +31,8 @@ class MotionSolver {
 
 // The solver of `kind` for `world`, which outlives it.
 std::unique_ptr<MotionSolver> MakeMotionSolver(MotionSolverKind kind, WorldImpl* world);
+// The soft step (soft_step_solver.cc).
+std::unique_ptr<MotionSolver> MakeSoftStepSolver(WorldImpl* world);
 
 }  // namespace rigid_body_sim::physics
 

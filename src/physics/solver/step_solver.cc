@@ -173,12 +173,9 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
   }
 }
 
-// Baraff's order within a step: colliding contacts get impulses on the
-// velocities the step starts with, then the forces act, then the resting
-// contacts get the impulses that keep them apart, all contacts at once.
-void WorldImpl::SolveContacts(const StepContext& step) {
-  // The bodies that move this step; the stages from here on visit only
-  // them, so sleeping bodies cost nothing.
+// The bodies that move this step; the stages from here on visit only them,
+// so sleeping bodies cost nothing.
+void WorldImpl::ListMovingBodies() {
   moving_bodies_.clear();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Body& body = bodies_[i];
@@ -186,6 +183,13 @@ void WorldImpl::SolveContacts(const StepContext& step) {
       moving_bodies_.push_back(i);
     }
   }
+}
+
+// Baraff's order within a step: colliding contacts get impulses on the
+// velocities the step starts with, then the forces act, then the resting
+// contacts get the impulses that keep them apart, all contacts at once.
+void WorldImpl::SolveContacts(const StepContext& step) {
+  ListMovingBodies();
   // The contact solver takes the pairs of rigid bodies; the articulations'
   // system, after it, the pairs with a link (articulation_step.cc).
   articulations_.TakeLinkPairs(contact_cache_.touching(), &rigid_pairs_);
@@ -289,6 +293,8 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
       point.feature = contact.feature;
       point.normal_impulse = pair->warm_start[i].normal_impulse;
       point.tangent_impulse = pair->warm_start[i].tangent_impulse;
+      point.preload = pair->warm_start[i].preload;
+      point.carried_approach = pair->warm_start[i].approach_velocity;
     }
   }
 }
@@ -306,8 +312,10 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
     pair.previous_count = manifold.point_count;
     for (int i = 0; i < manifold.point_count; ++i) {
       const SolverPoint& point = manifold.points[i];
-      pair.previous[i] = CachedImpulse{point.feature, point.normal_impulse, point.tangent_impulse,
-                                       pair.manifold.points[i].position_world};
+      pair.previous[i] =
+          CachedImpulse{point.feature,         point.normal_impulse,
+                        point.tangent_impulse, pair.manifold.points[i].position_world,
+                        point.preload,         point.carried_approach};
       const bool touching = point.separation <= settings_.solver.contact_tolerance;
       const double impulse = point.collision_impulse + point.normal_impulse;
       // A collision is reported only where an impulse resolved it; a

@@ -103,7 +103,8 @@ class WorldImpl : public LinkBodies {
   }
 
  private:
-  friend class ExactSolver;  // runs stages 4 and 5 below
+  friend class ExactSolver;     // runs stages 4 and 5 below
+  friend class SoftStepSolver;  // likewise, with its own sub-steps
 
   Body& MutableBody(BodyId id);
   // LinkBodies, for the articulation system.
@@ -120,6 +121,8 @@ class WorldImpl : public LinkBodies {
   void UpdateNarrowPhase(const StepContext& step);  // 2. narrow phase: manifolds per shape pair
   void UpdateContactCache();                        // 3. contact cache: witnesses, warm starts
   void SolveContacts(const StepContext& step);  // 4. solver: collisions, forces, resting contact
+  // The awake, enabled bodies that are not links into moving_bodies_.
+  void ListMovingBodies();
   // Stage 4's parts (step_solver.cc).
   void SolveTouching(const StepContext& step, const std::vector<ShapePairContact*>& pairs);
   void HoldPushedBodies();

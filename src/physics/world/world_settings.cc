@@ -48,6 +48,24 @@ Status ValidateSolverSettings(const SolverSettings& settings) {
   });
 }
 
+Status ValidateSoftStepSettings(const SoftStepSettings& settings) {
+  return FirstError({
+      settings.substeps >= 1 && settings.substeps <= kMaxSoftSubsteps
+          ? Status::Ok()
+          : Status::Error("substeps " + std::to_string(settings.substeps) + " must be in [1, " +
+                          std::to_string(kMaxSoftSubsteps) + "]"),
+      FiniteAbove("contact_hertz", settings.contact_hertz, 0.0, true, "finite and > 0 (Hz)"),
+      FiniteAbove("contact_damping_ratio", settings.contact_damping_ratio, 0.0, false,
+                  "finite and >= 0"),
+      FiniteAbove("max_push_velocity", settings.max_push_velocity, 0.0, true,
+                  "finite and > 0 (m/s)"),
+      settings.load_tracking >= 0.0 && settings.load_tracking <= 1.0
+          ? Status::Ok()
+          : Status::Error("load_tracking " + FormatNumber(settings.load_tracking) +
+                          " must be in [0, 1]"),
+  });
+}
+
 Status ValidateWorldSettings(const WorldSettings& settings) {
   if (!IsFinite(settings.gravity)) {
     return Status::Error("gravity [" + FormatNumber(settings.gravity.x()) + ", " +
@@ -86,17 +104,21 @@ Status ValidateWorldSettings(const WorldSettings& settings) {
                               std::to_string(kMaxThreads) + "] (0: one per core)"),
           FiniteAbove("sleep.speeding_up_time", sleep.speeding_up_time, 0.0, false,
                       "finite and >= 0 (s)"),
-          settings.motion_solver == MotionSolverKind::kExact
+          settings.motion_solver == MotionSolverKind::kExact ||
+                  settings.motion_solver == MotionSolverKind::kSoftStep
               ? Status::Ok()
               : Status::Error("motion_solver " +
                               std::to_string(static_cast<int>(settings.motion_solver)) +
-                              " is not a solver; kExact (0) is the one there is"),
+                              " is not a solver: kExact (0) or kSoftStep (1)"),
       });
       !status.ok()) {
     return status;
   }
   if (Status status = ValidateSolverSettings(settings.solver); !status.ok()) {
     return Status::Error("solver." + status.message());
+  }
+  if (Status status = ValidateSoftStepSettings(settings.soft_step); !status.ok()) {
+    return Status::Error("soft_step." + status.message());
   }
   return Status::Ok();
 }

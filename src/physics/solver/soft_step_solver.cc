@@ -1,0 +1,193 @@
+// The soft step behind the MotionSolver seam (soft_contact_solver.h): the
+// world's bodies loaded into the sub-steps, and their new velocities and
+// poses written back. The articulations keep their own solve (the same for
+// both solvers), after the rigid bodies': a body that touches a link takes
+// the velocity change that solve gives it on top of its sub-stepped motion.
+#include <algorithm>
+#include <cmath>
+
+#include "physics/solver/motion_solver.h"
+#include "physics/solver/soft_contact_solver.h"
+#include "physics/world/world_impl.h"
+
+namespace rigid_body_sim::physics {
+namespace {
+
+// L = I_world w, with I_world = R diag(I) R^T at the body's orientation.
+Vec3 AngularMomentum(const Body& body, const Vec3& angular_velocity) {
+  const Mat3 rotation = body.orientation.toRotationMatrix();
+  return rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+         (rotation.transpose() * angular_velocity);
+}
+
+}  // namespace
+
+class SoftStepSolver final : public MotionSolver {
+ public:
+  explicit SoftStepSolver(WorldImpl* world) : world_(*world) {}
+  void Solve(const StepContext& step) override;
+  void Integrate(const StepContext& step) override;
+
+ private:
+  void SeedNewSupports(const StepContext& step);
+  void LoadBodies(const StepContext& step);
+  void StoreVelocities();
+
+  WorldImpl& world_;
+  SoftContactSolver solver_;
+  std::vector<SoftBody> bodies_;            // per body slot
+  std::vector<FrictionAnchor> anchors_;     // per manifold
+  std::vector<std::uint8_t> touches_link_;  // per body slot, Integrate's
+};
+
+std::unique_ptr<MotionSolver> MakeSoftStepSolver(WorldImpl* world) {
+  return std::make_unique<SoftStepSolver>(world);
+}
+
+void SoftStepSolver::Solve(const StepContext& step) {
+  WorldImpl& w = world_;
+  w.ListMovingBodies();
+  w.articulations_.TakeLinkPairs(w.contact_cache_.touching(), &w.rigid_pairs_);
+  w.solver_.Reset(w.settings_.solver, step.dt, w.bodies_.size());
+  w.BuildSolverManifolds(w.rigid_pairs_);
+  SeedNewSupports(step);
+  LoadBodies(step);
+  SoftStepInput input;
+  input.dt = step.dt;
+  input.settings = w.settings_.soft_step;
+  input.collision_velocity_threshold = w.settings_.solver.collision_velocity_threshold;
+  // A point a tenth of the contact margin apart touches: a face landing
+  // flat stops on its first corners' speculative rows, the others a fraction
+  // of a millimetre up.
+  input.touch_tolerance =
+      std::max(w.settings_.solver.contact_tolerance, 0.1 * w.settings_.contact_margin);
+  anchors_.resize(w.rigid_pairs_.size());
+  for (std::size_t m = 0; m < w.rigid_pairs_.size(); ++m) {
+    anchors_[m] = w.rigid_pairs_[m]->friction_anchor;
+  }
+  solver_.Step(input, step.pool, &bodies_, &w.solver_.manifolds(), &anchors_);
+  for (std::size_t m = 0; m < w.rigid_pairs_.size(); ++m) {
+    w.rigid_pairs_[m]->friction_anchor = anchors_[m];
+  }
+  StoreVelocities();
+  w.DisableNonFiniteBodies();
+  w.articulations_.Solve(step);
+  w.ReportContacts(w.rigid_pairs_, step, /*impacts_only=*/false);
+  w.articulations_.ReportContacts(step, &w.contacts_, &w.collision_log_);
+}
+
+// A new support starts from the load it would carry at rest (the exact
+// solver's estimate, SeedNewSupportLoads), both as its warm start and as its
+// spring's preload: a stack spawned at rest then starts near its
+// equilibrium, instead of sagging on unloaded springs while the load
+// tracking catches up.
+void SoftStepSolver::SeedNewSupports(const StepContext& step) {
+  WorldImpl& w = world_;
+  w.SeedNewSupportLoads(w.rigid_pairs_, step);
+  std::vector<SolverManifold>& manifolds = w.solver_.manifolds();
+  for (std::size_t m = 0; m < manifolds.size(); ++m) {
+    if (w.rigid_pairs_[m]->previous_count != 0) continue;
+    for (int i = 0; i < manifolds[m].point_count; ++i) {
+      manifolds[m].points[i].preload = manifolds[m].points[i].normal_impulse;
+    }
+  }
+}
+
+// The moving bodies with their velocities (the spin capped at
+// max_turn_per_step, as the exact solver's) and their accelerations, which
+// the sub-steps hold constant; the other bodies the contacts reach, as
+// bodies the solve never moves.
+void SoftStepSolver::LoadBodies(const StepContext& step) {
+  WorldImpl& w = world_;
+  bodies_.resize(w.bodies_.size());
+  for (const SolverManifold& manifold : w.solver_.manifolds()) {
+    for (const std::uint32_t i : {manifold.body_a, manifold.body_b}) {
+      bodies_[i] = SoftBody();
+      bodies_[i].position = w.bodies_[i].position;
+      bodies_[i].orientation = w.bodies_[i].orientation;
+    }
+  }
+  const double max_spin = w.settings_.max_turn_per_step / step.dt;
+  for (const std::uint32_t i : w.moving_bodies_) {
+    Body& body = w.bodies_[i];
+    SoftBody& soft = bodies_[i];
+    soft = SoftBody();
+    soft.position = body.position;
+    soft.orientation = body.orientation;
+    if (body.disabled) continue;
+    soft.linear_velocity = body.linear_velocity;
+    soft.angular_velocity = body.angular_velocity;
+    const double spin = soft.angular_velocity.norm();
+    if (spin > max_spin) soft.angular_velocity *= max_spin / spin;
+    soft.linear_acceleration = w.settings_.gravity + body.inverse_mass * body.force;
+    soft.angular_acceleration = body.inverse_inertia_world * body.torque;
+    body.force.setZero();
+    body.torque.setZero();
+    soft.inverse_mass = body.inverse_mass;
+    soft.inverse_inertia_world = body.inverse_inertia_world;
+    soft.reach = body.bounding_radius;
+    soft.moving = true;
+  }
+}
+
+// The end velocities as momenta, P = M v and L = I_world w, still about the
+// start orientation: the pose is written by Integrate, after the
+// articulations' solve has had its say on the bodies that touch a link.
+void SoftStepSolver::StoreVelocities() {
+  WorldImpl& w = world_;
+  for (const std::uint32_t i : w.moving_bodies_) {
+    Body& body = w.bodies_[i];
+    const SoftBody& soft = bodies_[i];
+    if (!soft.moving) continue;
+    body.linear_momentum = body.mass * soft.linear_velocity;
+    body.angular_momentum = AngularMomentum(body, soft.angular_velocity);
+    body.start_linear_velocity = soft.linear_velocity;
+    body.start_angular_momentum = body.angular_momentum;
+    body.pseudo_linear_velocity.setZero();
+    body.pseudo_angular_velocity.setZero();
+    body.UpdateDerived();
+  }
+}
+
+// Each moving body takes the motion of its sub-steps. A body that touches a
+// link drifts instead with the velocity the articulations' solve ended it
+// with (and its split-impulse velocity), x += dt v, as the exact solver's
+// pushed bodies do: that solve holds a gripped box at its fingers' velocity
+// at the end of the step, and the sub-steps' drift, which lags that by
+// (n - 1) / 2n g dt^2 each step, let the box slip out of a still grip.
+void SoftStepSolver::Integrate(const StepContext& step) {
+  WorldImpl& w = world_;
+  w.articulations_.Move();
+  touches_link_.assign(w.bodies_.size(), 0);
+  for (const ShapePairContact* pair : w.articulations_.link_pairs()) {
+    touches_link_[pair->body_a] = 1;
+    touches_link_[pair->body_b] = 1;
+  }
+  for (const std::uint32_t i : w.moving_bodies_) {
+    Body& body = w.bodies_[i];
+    const SoftBody& soft = bodies_[i];
+    if (!soft.moving || body.disabled) continue;
+    const Vec3 angular_velocity = body.angular_velocity;
+    Vec3 moved = soft.delta_position;
+    Vec3 turn = Vec3::Zero();
+    if (touches_link_[i]) {
+      moved = step.dt * (body.linear_velocity + body.pseudo_linear_velocity);
+      turn = step.dt * (angular_velocity + body.pseudo_angular_velocity);
+    } else {
+      body.orientation = (soft.delta_rotation * body.orientation).normalized();
+    }
+    body.position += moved;
+    const double angle = turn.norm();
+    if (angle > 0.0) {
+      body.orientation =
+          (Quat(Eigen::AngleAxisd(angle, turn / angle)) * body.orientation).normalized();
+    }
+    body.angular_momentum = AngularMomentum(body, angular_velocity);
+    body.UpdateDerived();
+    body.travel += touches_link_[i] ? moved.norm() + angle * body.bounding_radius : soft.travel;
+  }
+  w.DisableNonFiniteBodies();
+  w.UpdateSleep(step);
+}
+
+}  // namespace rigid_body_sim::physics
