@@ -456,6 +456,8 @@ LiveSettings LiveSettingsFromConfig(const rigid_body_sim::PhysicsConfig& config)
   settings.defaults.restitution = config.default_restitution;
   settings.velocity_iterations = config.solver_velocity_iterations;
   settings.position_iterations = config.solver_position_iterations;
+  settings.solver_method = config.solver_method;
+  settings.soft_substeps = config.solver_soft_step_substeps;
   settings.sleep_linear_velocity = config.sleep_linear_velocity;
   settings.sleep_angular_velocity = config.sleep_angular_velocity;
   return settings;
@@ -472,6 +474,8 @@ void LiveSettingsToConfig(const LiveSettings& settings, rigid_body_sim::PhysicsC
   config->default_restitution = settings.defaults.restitution;
   config->solver_velocity_iterations = settings.velocity_iterations;
   config->solver_position_iterations = settings.position_iterations;
+  config->solver_method = settings.solver_method;
+  config->solver_soft_step_substeps = settings.soft_substeps;
   config->sleep_linear_velocity = settings.sleep_linear_velocity;
   config->sleep_angular_velocity = settings.sleep_angular_velocity;
 }

@@ -165,6 +165,21 @@ physics::Quat QuatFromRollPitchYaw(double roll, double pitch, double yaw) {
                        Eigen::AngleAxisd(roll, Vec3::UnitX()));
 }
 
+bool SolverMethodFromName(const std::string& name, physics::MotionSolverKind* kind) {
+  if (name == kExactSolver) {
+    *kind = physics::MotionSolverKind::kExact;
+  } else if (name == kSoftStepSolver) {
+    *kind = physics::MotionSolverKind::kSoftStep;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+std::string SolverMethodName(physics::MotionSolverKind kind) {
+  return kind == physics::MotionSolverKind::kSoftStep ? kSoftStepSolver : kExactSolver;
+}
+
 LiveSettings LiveSettingsOf(const NodeOptions& options) {
   LiveSettings live;
   live.gravity = options.world.gravity;
@@ -174,6 +189,8 @@ LiveSettings LiveSettingsOf(const NodeOptions& options) {
   live.defaults = options.defaults;
   live.velocity_iterations = options.world.solver.velocity_iterations;
   live.position_iterations = options.world.solver.position_iterations;
+  live.solver_method = options.solver_method;
+  live.soft_substeps = options.world.soft_step.substeps;
   live.sleep_linear_velocity = options.world.sleep.linear_velocity;
   live.sleep_angular_velocity = options.world.sleep.angular_velocity;
   return live;
@@ -185,6 +202,9 @@ physics::WorldSettings WithLiveSettings(physics::WorldSettings world,
   world.time_step = settings.time_step;
   world.solver.velocity_iterations = settings.velocity_iterations;
   world.solver.position_iterations = settings.position_iterations;
+  // Validated names only reach here (ValidateLiveSettings).
+  SolverMethodFromName(settings.solver_method, &world.motion_solver);
+  world.soft_step.substeps = settings.soft_substeps;
   world.sleep.linear_velocity = settings.sleep_linear_velocity;
   world.sleep.angular_velocity = settings.sleep_angular_velocity;
   return world;
@@ -199,6 +219,13 @@ Status CheckRange(const std::string& name, double value, double low, double high
   const std::string shown_unit = unit.empty() ? "" : " " + unit;
   return Status::Error(name + " " + FormatNumber(value) + shown_unit + " is outside [" +
                        FormatNumber(low) + ", " + FormatNumber(high) + "]" + shown_unit);
+}
+
+Status CheckSolverMethod(const std::string& name, const std::string& method) {
+  physics::MotionSolverKind kind;
+  if (SolverMethodFromName(method, &kind)) return Status::Ok();
+  return Status::Error(name + " '" + method + "' is not a solver: '" + kExactSolver + "' or '" +
+                       kSoftStepSolver + "'");
 }
 
 }  // namespace
@@ -224,6 +251,9 @@ Status ValidateLiveSettings(const LiveSettings& settings, const std::string& pre
                       kMaxIterations, ""),
            CheckRange(prefix + "solver/position_iterations", settings.position_iterations, 0,
                       kMaxIterations, ""),
+           CheckSolverMethod(prefix + "solver/method", settings.solver_method),
+           CheckRange(prefix + "solver/soft_step/substeps", settings.soft_substeps, 1,
+                      physics::kMaxSoftSubsteps, ""),
            CheckRange(prefix + "sleep/linear_velocity", settings.sleep_linear_velocity, 0.0,
                       kMaxSleepVelocity, "m/s"),
            CheckRange(prefix + "sleep/angular_velocity", settings.sleep_angular_velocity, 0.0,
@@ -324,7 +354,7 @@ Status ValidateNodeOptions(const NodeOptions& options) {
   if (Status status = physics::ValidateWorldSettings(options.world); !status.ok()) {
     return Status::Error(
         "world settings (~gravity, ~time_step, ~contact_margin, "
-        "~continuous_fraction, ~solver, ~sleep): " +
+        "~continuous_fraction, ~solver, ~solver/soft_step, ~sleep): " +
         status.message());
   }
   if (Status status = ValidateLiveSettings(LiveSettingsOf(options), "~"); !status.ok()) {
@@ -391,6 +421,12 @@ std::vector<ScalarParam> ScalarParams(NodeOptions* options) {
       {"solver/max_collision_rounds", &solver.max_collision_rounds},
       {"solver/collision_iterations", &solver.collision_iterations},
       {"solver/max_pivoting_points", &solver.max_pivoting_points},
+      {"solver/method", &options->solver_method},
+      {"solver/soft_step/substeps", &world.soft_step.substeps},
+      {"solver/soft_step/contact_hertz", &world.soft_step.contact_hertz},
+      {"solver/soft_step/contact_damping_ratio", &world.soft_step.contact_damping_ratio},
+      {"solver/soft_step/max_push_velocity", &world.soft_step.max_push_velocity},
+      {"solver/soft_step/load_tracking", &world.soft_step.load_tracking},
       {"sleep/enabled", &sleep.enabled},
       {"sleep/linear_velocity", &sleep.linear_velocity},
       {"sleep/angular_velocity", &sleep.angular_velocity},
@@ -475,6 +511,7 @@ Result<NodeOptions> ReadNodeOptions(const ros::NodeHandle& private_node) {
   }
   if (Status status = ReadModels(private_node, &options.models); !status.ok()) return status;
   if (Status status = ValidateNodeOptions(options); !status.ok()) return status;
+  SolverMethodFromName(options.solver_method, &options.world.motion_solver);
   if (options.world.time_step > kWarnTimeStep) {
     ROS_WARN("~time_step %g s is above %g s: contacts and fast bodies will be coarse",
              options.world.time_step, kWarnTimeStep);

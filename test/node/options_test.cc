@@ -50,6 +50,31 @@ TEST(OptionsTest, BadValuesAreNamed) {
       << ValidateNodeOptions(options).message();
 }
 
+// ~solver/method names one of the two solvers; anything else, and a soft
+// step setting out of its range, is refused with its name.
+TEST(OptionsTest, SolverMethodIsExactOrSoftStep) {
+  NodeOptions options;
+  EXPECT_EQ(options.solver_method, "exact");
+  options.solver_method = "soft_step";
+  EXPECT_TRUE(ValidateNodeOptions(options).ok());
+  physics::MotionSolverKind kind = physics::MotionSolverKind::kExact;
+  ASSERT_TRUE(SolverMethodFromName(options.solver_method, &kind));
+  EXPECT_EQ(kind, physics::MotionSolverKind::kSoftStep);
+  EXPECT_EQ(SolverMethodName(kind), "soft_step");
+  options.solver_method = "pgs";
+  EXPECT_EQ(ValidateNodeOptions(options).message(),
+            "~solver/method 'pgs' is not a solver: 'exact' or 'soft_step'");
+  options = NodeOptions();
+  options.world.soft_step.substeps = 65;
+  EXPECT_NE(ValidateNodeOptions(options).message().find("soft_step.substeps 65 must be in [1, 64]"),
+            std::string::npos)
+      << ValidateNodeOptions(options).message();
+  options = NodeOptions();
+  options.world.soft_step.load_tracking = 2.0;
+  EXPECT_NE(ValidateNodeOptions(options).message().find("load_tracking 2 must be in [0, 1]"),
+            std::string::npos);
+}
+
 // ~threads defaults to one thread; 0 (every core) and 2 are valid.
 TEST(OptionsTest, ThreadsDefaultToOne) {
   NodeOptions options;

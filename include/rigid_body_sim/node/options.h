@@ -26,6 +26,14 @@ inline physics::WorldSettings NodeWorldSettings() {
   return world;
 }
 
+// ~solver/method's values, as physics::MotionSolverKind's.
+inline constexpr const char* kExactSolver = "exact";
+inline constexpr const char* kSoftStepSolver = "soft_step";
+
+// The solver `name` names (kExactSolver or kSoftStepSolver), or false.
+bool SolverMethodFromName(const std::string& name, physics::MotionSolverKind* kind);
+std::string SolverMethodName(physics::MotionSolverKind kind);
+
 struct NodeOptions {
   std::string world_frame = "world";  // ~world_frame: parent of every body frame
   // ~gravity [x, y, z] (m/s^2, default [0, 0, -9.81]), ~time_step (s, > 0,
@@ -40,6 +48,12 @@ struct NodeOptions {
   // (count, [0, 256], default 1; 0: one per core) is the threads a step runs on; any count gives
   // the same motion bit for bit.
   physics::WorldSettings world = NodeWorldSettings();
+  // ~solver/method: "exact" (default) or "soft_step" (kSolverMethods),
+  // which sets world.motion_solver; the soft step's own parameters are
+  // ~solver/soft_step/{substeps (count, [1, 64], 4), contact_hertz (Hz, > 0,
+  // 30), contact_damping_ratio (>= 0, 10), max_push_velocity (m/s, > 0, 3),
+  // load_tracking ([0, 1], 0.05)}; see physics/world_settings.h.
+  std::string solver_method = kExactSolver;
   double real_time_factor = 1.0;    // ~real_time_factor: sim time / real time, >= 0; 0 = flat out
   double publish_rate = 50.0;       // ~publish_rate: Hz of /tf, ~states, ~contacts, > 0
   bool paused = false;              // ~paused: start without stepping
@@ -100,8 +114,10 @@ struct LiveSettings {
   MaterialDefaults defaults;
   int velocity_iterations = 20;  // solver sweeps
   int position_iterations = 6;
-  double sleep_linear_velocity = 0.05;  // m/s
-  double sleep_angular_velocity = 0.1;  // rad/s
+  std::string solver_method = kExactSolver;  // ~solver/method
+  int soft_substeps = 4;                     // ~solver/soft_step/substeps
+  double sleep_linear_velocity = 0.05;       // m/s
+  double sleep_angular_velocity = 0.1;       // rad/s
 };
 
 // Ranges of the live settings; gravity, time step, real-time factor and
