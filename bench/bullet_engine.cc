@@ -102,6 +102,8 @@ std::string EngineName(EngineKind kind) {
   switch (kind) {
     case EngineKind::kOurs:
     case EngineKind::kOursTwoThreads:
+    case EngineKind::kOursSoft:
+    case EngineKind::kOursSoftTwoThreads:
       return "ours";
     case EngineKind::kBullet:
       return "bullet";
@@ -115,15 +117,35 @@ std::string EngineName(EngineKind kind) {
   return "";
 }
 
-int EngineThreads(EngineKind kind) { return kind == EngineKind::kOursTwoThreads ? 2 : 1; }
+int EngineThreads(EngineKind kind) {
+  return kind == EngineKind::kOursTwoThreads || kind == EngineKind::kOursSoftTwoThreads ? 2 : 1;
+}
+
+std::string EngineSolver(EngineKind kind) {
+  switch (kind) {
+    case EngineKind::kOurs:
+    case EngineKind::kOursTwoThreads:
+      return "exact";
+    case EngineKind::kOursSoft:
+    case EngineKind::kOursSoftTwoThreads:
+      return "soft_step";
+    case EngineKind::kBullet:
+    case EngineKind::kBulletOurSleep:
+    case EngineKind::kMujocoRk4:
+    case EngineKind::kMujocoEuler:
+      break;
+  }
+  return "";
+}
 
 std::unique_ptr<Engine> MakeEngine(EngineKind kind, const Scene& scene,
                                    const OurSettingsOverrides& overrides) {
-  if (kind == EngineKind::kOurs) return MakeOurEngine(scene, overrides);
-  if (kind == EngineKind::kOursTwoThreads) {
-    OurSettingsOverrides two = overrides;
-    two.threads = 2;
-    return MakeOurEngine(scene, two);
+  if (!EngineSolver(kind).empty()) {
+    OurSettingsOverrides ours = overrides;
+    ours.threads = EngineThreads(kind);
+    ours.motion_solver = EngineSolver(kind) == "soft_step" ? physics::MotionSolverKind::kSoftStep
+                                                           : physics::MotionSolverKind::kExact;
+    return MakeOurEngine(scene, ours);
   }
   if (kind == EngineKind::kMujocoRk4 || kind == EngineKind::kMujocoEuler) {
     return MakeMujocoEngine(scene, kind == EngineKind::kMujocoRk4);

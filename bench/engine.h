@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "rigid_body_sim/physics/world_settings.h"
 #include "scene.h"
 
 namespace rigid_body_sim::bench {
@@ -74,25 +75,33 @@ struct OurSettingsOverrides {
   std::optional<bool>
       batch_independent_runs;  // the sweeps update runs four at a time in SIMD lanes
   std::optional<int> threads;  // WorldSettings::threads, [0, 256]
+  std::optional<physics::MotionSolverKind> motion_solver;  // WorldSettings::motion_solver
 };
 
 // The engines under test: ours on one thread; Bullet with its defaults;
 // Bullet with the sleep thresholds of ours (bullet_engine.cc); ours on two
-// threads; in the articulated scenes also MuJoCo with its RK4 and with its
-// Euler integrator (mujoco_engine.cc). Bullet's multi-threaded world is left
-// out: Debian's build has no thread-safe Bullet (performance.md).
+// threads; ours with the soft step (MotionSolverKind::kSoftStep) on one and
+// on two threads; in the articulated scenes also MuJoCo with its RK4 and
+// with its Euler integrator (mujoco_engine.cc). Bullet's multi-threaded
+// world is left out: Debian's build has no thread-safe Bullet
+// (performance.md).
 enum class EngineKind {
   kOurs,
   kBullet,
   kBulletOurSleep,
   kOursTwoThreads,
   kMujocoRk4,
-  kMujocoEuler
+  kMujocoEuler,
+  kOursSoft,
+  kOursSoftTwoThreads
 };
-// "ours", "bullet", "bullet_oursleep", "mujoco_rk4" or "mujoco_euler"; both
-// of ours are "ours", told apart by EngineThreads.
+// "ours", "bullet", "bullet_oursleep", "mujoco_rk4" or "mujoco_euler"; all
+// four of ours are "ours", told apart by EngineThreads and EngineSolver, so
+// that the CSV's engine column keeps the values older tooling knows.
 std::string EngineName(EngineKind kind);
 int EngineThreads(EngineKind kind);
+// Ours: its motion solver, "exact" or "soft_step"; "" for the other engines.
+std::string EngineSolver(EngineKind kind);
 
 // Bullet's sleeping: its defaults, or the thresholds of ours.
 struct BulletSleep {

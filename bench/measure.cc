@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <random>
@@ -309,6 +310,7 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
   summary.scene = scene.name;
   summary.engine = EngineName(kind);
   summary.threads = EngineThreads(kind);
+  summary.solver = EngineSolver(kind);
   summary.bodies = static_cast<int>(scene.bodies.size());
   for (const BenchArticulation& articulation : scene.articulations) {
     summary.bodies += static_cast<int>(articulation.links.size()) - 1;  // the moving links
@@ -363,8 +365,10 @@ Summary Summarize(const Scene& scene, EngineKind kind, std::vector<RunResult> re
 }  // namespace
 
 std::string EngineLabel(const Summary& summary) {
-  return summary.threads > 1 ? summary.engine + " x" + std::to_string(summary.threads)
-                             : summary.engine;
+  std::string label = summary.engine;
+  if (summary.solver == "soft_step") label += " soft_step";
+  if (summary.threads > 1) label += " x" + std::to_string(summary.threads);
+  return label;
 }
 
 namespace {
@@ -379,18 +383,43 @@ void AddRatios(const RunResult& mine, const RunResult& other, std::vector<double
   }
 }
 
+// One of ours, as the numerator of a pair of ratio columns of every other
+// engine's row (Summary).
+struct RatioNumerator {
+  EngineKind kind;
+  double Summary::*over_this;
+  double Summary::*over_this_awake;
+};
+
+constexpr RatioNumerator kRatioNumerators[] = {
+    {EngineKind::kOurs, &Summary::ours_over_this, &Summary::ours_over_this_awake},
+    {EngineKind::kOursTwoThreads, &Summary::ours2_over_this, &Summary::ours2_over_this_awake},
+    {EngineKind::kOursSoft, &Summary::soft_over_this, &Summary::soft_over_this_awake},
+    {EngineKind::kOursSoftTwoThreads, &Summary::soft2_over_this, &Summary::soft2_over_this_awake},
+};
+constexpr std::size_t kNumerators = std::size(kRatioNumerators);
+
+// One numerator's ratios to each engine, run by run.
+struct RunRatios {
+  std::vector<std::vector<double>> step;   // per engine
+  std::vector<std::vector<double>> awake;  // per engine
+};
+
 }  // namespace
 
 std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSettings& settings,
                                     const std::vector<EngineKind>& engines) {
   const std::size_t count = engines.size();
   std::vector<std::vector<RunResult>> results(count);
-  std::vector<std::vector<double>> ratios(count);
-  std::vector<std::vector<double>> awake_ratios(count);
-  std::vector<std::vector<double>> two_ratios(count);
-  std::vector<std::vector<double>> two_awake_ratios(count);
-  const std::size_t two = static_cast<std::size_t>(
-      std::find(engines.begin(), engines.end(), EngineKind::kOursTwoThreads) - engines.begin());
+  // Where each numerator is among `engines`; count when it is not there.
+  std::size_t numerator_at[kNumerators];
+  std::vector<RunRatios> ratios(kNumerators);
+  for (std::size_t n = 0; n < kNumerators; ++n) {
+    numerator_at[n] = static_cast<std::size_t>(
+        std::find(engines.begin(), engines.end(), kRatioNumerators[n].kind) - engines.begin());
+    ratios[n].step.resize(count);
+    ratios[n].awake.resize(count);
+  }
   for (int run = 0; run < runs; ++run) {
     const Scene jittered = JitterScene(scene, run);
     std::vector<RunResult> this_run(count);
@@ -407,23 +436,24 @@ std::vector<Summary> MeasureEngines(const Scene& scene, int runs, const RunSetti
     // A run that diverged is no ratio's denominator, nor its numerator:
     // an engine that blew up measured the time of another computation.
     for (std::size_t e = 0; e < count; ++e) ok[e] = ok[e] && !this_run[e].diverged;
-    // Ours is engines[0]: its ratio to each other engine in this run.
-    for (std::size_t e = 1; e < count && ok[0]; ++e) {
-      if (ok[e]) AddRatios(this_run[0], this_run[e], &ratios[e], &awake_ratios[e]);
-    }
-    // Ours on two threads, when among them: its ratio to each other engine.
-    for (std::size_t e = 0; e < count && two < count && ok[two]; ++e) {
-      if (ok[e] && e != two)
-        AddRatios(this_run[two], this_run[e], &two_ratios[e], &two_awake_ratios[e]);
+    // Each of ours that ran: its ratio to each other engine in this run.
+    for (std::size_t n = 0; n < kNumerators; ++n) {
+      const std::size_t mine = numerator_at[n];
+      if (mine >= count || !ok[mine]) continue;
+      for (std::size_t e = 0; e < count; ++e) {
+        if (ok[e] && e != mine) {
+          AddRatios(this_run[mine], this_run[e], &ratios[n].step[e], &ratios[n].awake[e]);
+        }
+      }
     }
   }
   std::vector<Summary> summaries;
   for (std::size_t e = 0; e < count; ++e) {
     summaries.push_back(Summarize(scene, engines[e], std::move(results[e])));
-    summaries.back().ours_over_this = Median(std::move(ratios[e]));
-    summaries.back().ours_over_this_awake = Median(std::move(awake_ratios[e]));
-    summaries.back().ours2_over_this = Median(std::move(two_ratios[e]));
-    summaries.back().ours2_over_this_awake = Median(std::move(two_awake_ratios[e]));
+    for (std::size_t n = 0; n < kNumerators; ++n) {
+      summaries.back().*kRatioNumerators[n].over_this = Median(std::move(ratios[n].step[e]));
+      summaries.back().*kRatioNumerators[n].over_this_awake = Median(std::move(ratios[n].awake[e]));
+    }
   }
   return summaries;
 }

@@ -82,6 +82,7 @@ struct Summary {
   std::string scene;
   std::string engine;
   int threads = 1;
+  std::string solver;  // EngineSolver: ours' motion solver, "" for the other engines
   int bodies = 0;
   double seconds = 0.0;
   double time_step = kDefaultTimeStep;  // s
@@ -94,18 +95,25 @@ struct Summary {
   // step; 0 when none had.
   double awake_ms_median = 0.0;
   long peak_rss_kb = 0;  // largest over the runs
-  // Other engines than ours: the medians over the runs of ours / this
-  // engine, ms per step and ms per awake step, each pair of runs made back
-  // to back (MeasureEngines); 0 when not measured. Runs that diverged, this
-  // engine's or ours, give no ratio.
+  // Every row but ours on one thread with the exact solver: the medians
+  // over the runs of that engine / this row's, ms per step and ms per awake
+  // step, each pair of runs made back to back (MeasureEngines); 0 when not
+  // measured. Runs that diverged, this engine's or ours, give no ratio.
   double ours_over_this = 0.0;
   double ours_over_this_awake = 0.0;
-  // The same for ours on two threads over this engine, when it ran.
+  // The same for ours on two threads (exact) over this row, when it ran.
   double ours2_over_this = 0.0;
   double ours2_over_this_awake = 0.0;
+  // The same for ours with the soft step, on one and on two threads: on
+  // the exact rows, how much of ours' time the soft step takes.
+  double soft_over_this = 0.0;
+  double soft_over_this_awake = 0.0;
+  double soft2_over_this = 0.0;
+  double soft2_over_this_awake = 0.0;
 };
 
-// The engine's name, with its threads when more than one ("ours x2").
+// The engine's name, then ours' solver when it is not the exact one, then
+// its threads when more than one: "ours", "ours x2", "ours soft_step x2".
 std::string EngineLabel(const Summary& summary);
 
 // How every run of a benchmark is made.

@@ -102,6 +102,7 @@ class OurEngine : public Engine {
         overrides.batch_independent_runs.value_or(solver.batch_independent_runs);
     settings.sleep.time_to_sleep = overrides.time_to_sleep.value_or(settings.sleep.time_to_sleep);
     settings.threads = overrides.threads.value_or(settings.threads);
+    settings.motion_solver = overrides.motion_solver.value_or(settings.motion_solver);
     assert(physics::ValidateWorldSettings(settings).ok());
     world_ = std::make_unique<physics::World>(settings);
 

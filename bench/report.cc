@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <map>
 #include <sstream>
+#include <string>
+#include <utility>
 
 namespace rigid_body_sim::bench {
 namespace {
@@ -143,6 +145,23 @@ double RowCostNs(const RunResult& result) {
   return rows > 0.0 ? 1e6 * result.solver_rows_ms / rows : 0.0;
 }
 
+// The ratio columns of ours over a row that MeasureEngines measured; a
+// ratio not measured (0) leaves its column empty.
+void AddRatioValues(const Summary& summary, std::map<std::string, std::string>* values) {
+  const std::pair<const char*, double> kRatios[] = {
+      {"ours_over_this_ms_per_step", summary.ours_over_this},
+      {"ours_over_this_ms_per_awake_step", summary.ours_over_this_awake},
+      {"ours2_over_this_ms_per_step", summary.ours2_over_this},
+      {"ours2_over_this_ms_per_awake_step", summary.ours2_over_this_awake},
+      {"soft_over_this_ms_per_step", summary.soft_over_this},
+      {"soft_over_this_ms_per_awake_step", summary.soft_over_this_awake},
+      {"soft2_over_this_ms_per_step", summary.soft2_over_this},
+      {"soft2_over_this_ms_per_awake_step", summary.soft2_over_this_awake}};
+  for (const auto& [column, ratio] : kRatios) {
+    if (ratio > 0.0) (*values)[column] = Number(ratio);
+  }
+}
+
 std::string Ratio(double ratio) {
   if (ratio <= 0.0) return "";
   char text[32];
@@ -153,19 +172,21 @@ std::string Ratio(double ratio) {
 }  // namespace
 
 void PrintTableHeader() {
-  std::printf("%-12s %-15s %6s %6s %26s %9s %8s %8s %9s %9s %11s %7s  %s\n", "scene", "engine",
-              "bodies", "sim s", "ms/step med [min, max]", "awake ms", "ours/it", "awake", "KE J",
-              "pen mm", "peak pen mm", "RSS MB", "quality");
+  std::printf("%-12s %-17s %6s %6s %26s %9s %8s %8s %8s %8s %9s %9s %11s %7s  %s\n", "scene",
+              "engine", "bodies", "sim s", "ms/step med [min, max]", "awake ms", "ours/it", "awake",
+              "soft aw", "soft2 aw", "KE J", "pen mm", "peak pen mm", "RSS MB", "quality");
 }
 
 void PrintSceneRows(const Scene& scene, const std::vector<Summary>& summaries) {
   for (const Summary& summary : summaries) {
     const Quality quality = SceneQuality(scene, summary.median);
     std::printf(
-        "%-12s %-15s %6d %6.2f %9.3f [%7.3f,%7.3f] %9.3f %8s %8s %9.3g %9.2f %11.2f %7.1f  %s\n",
+        "%-12s %-17s %6d %6.2f %9.3f [%7.3f,%7.3f] %9.3f %8s %8s %8s %8s %9.3g %9.2f %11.2f %7.1f  "
+        "%s\n",
         scene.name.c_str(), EngineLabel(summary).c_str(), summary.bodies, summary.seconds,
         summary.ms_median, summary.ms_min, summary.ms_max, summary.awake_ms_median,
         Ratio(summary.ours_over_this).c_str(), Ratio(summary.ours_over_this_awake).c_str(),
+        Ratio(summary.soft_over_this_awake).c_str(), Ratio(summary.soft2_over_this_awake).c_str(),
         summary.median.final_kinetic_energy, 1e3 * summary.median.final_penetration,
         1e3 * summary.median.peak_penetration, summary.peak_rss_kb / 1024.0,
         (quality.text + ArticulatedFigures(scene, summary)).c_str());
@@ -183,13 +204,13 @@ void PrintStageProfile(const Rows& rows) {
       "simulated time of the steps with contact points to solve (the rest is free flight or "
       "asleep), ms/contact step = wall time of one of them; awake s = simulated time with "
       "every moving body awake\n");
-  std::printf("%-12s %-15s %9s %9s %9s %9s %13s %10s %16s %8s\n", "scene", "engine", "broad",
+  std::printf("%-12s %-17s %9s %9s %9s %9s %13s %10s %16s %8s\n", "scene", "engine", "broad",
               "narrow", "solver", "integr", "ns/row-iter", "contact s", "ms/contact step",
               "awake s");
   for (const std::vector<Summary>& scene_rows : rows) {
     for (const Summary& summary : scene_rows) {
       const RunResult& result = summary.median;
-      std::printf("%-12s %-15s %9.3f %9.3f %9.3f %9.3f %13.1f %10.2f %16.3f %8.2f\n",
+      std::printf("%-12s %-17s %9.3f %9.3f %9.3f %9.3f %13.1f %10.2f %16.3f %8.2f\n",
                   summary.scene.c_str(), EngineLabel(summary).c_str(), result.broad_phase_ms,
                   result.narrow_phase_ms, result.solver_ms, result.integrator_ms, RowCostNs(result),
                   result.contact_steps * summary.time_step, ContactStepMs(result),
@@ -245,12 +266,14 @@ void PrintScaling(const Rows& rows, double window_seconds) {
 
 const std::vector<std::string>& CsvColumns() {
   static const std::vector<std::string> kColumns = {
-      "scene", "engine", "threads", "steps", "ms_per_step_median", "ms_per_awake_step_median",
-      "max_penetration_m", "top_drift_m",
+      "scene", "engine", "threads", "solver", "steps", "ms_per_step_median",
+      "ms_per_awake_step_median", "max_penetration_m", "top_drift_m",
       // The rest of the report.
       "bodies", "sim_seconds", "ms_per_step_min", "ms_per_step_max", "steps_per_second",
       "ours_over_this_ms_per_step", "ours_over_this_ms_per_awake_step",
-      "ours2_over_this_ms_per_step", "ours2_over_this_ms_per_awake_step", "awake_seconds",
+      "ours2_over_this_ms_per_step", "ours2_over_this_ms_per_awake_step",
+      "soft_over_this_ms_per_step", "soft_over_this_ms_per_awake_step",
+      "soft2_over_this_ms_per_step", "soft2_over_this_ms_per_awake_step", "awake_seconds",
       "final_kinetic_energy_j", "final_penetration_m", "bounce_apex_m", "bounce_apex_error",
       "incline_slide_m", "incline_error", "joint_separation_m", "boxes_moved",
       "driven_joint_swept_rad", "driven_joint_commanded_rad", "broad_phase_ms", "narrow_phase_ms",
@@ -274,6 +297,7 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
           {"scene", summary.scene},
           {"engine", summary.engine},
           {"threads", std::to_string(summary.threads)},
+          {"solver", summary.solver},
           {"steps", std::to_string(result.steps)},
           {"ms_per_step_median", Number(summary.ms_median)},
           {"max_penetration_m", Number(result.peak_penetration)},
@@ -297,18 +321,7 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
       if (summary.awake_ms_median > 0.0) {
         values["ms_per_awake_step_median"] = Number(summary.awake_ms_median);
       }
-      if (summary.ours_over_this > 0.0) {
-        values["ours_over_this_ms_per_step"] = Number(summary.ours_over_this);
-      }
-      if (summary.ours_over_this_awake > 0.0) {
-        values["ours_over_this_ms_per_awake_step"] = Number(summary.ours_over_this_awake);
-      }
-      if (summary.ours2_over_this > 0.0) {
-        values["ours2_over_this_ms_per_step"] = Number(summary.ours2_over_this);
-      }
-      if (summary.ours2_over_this_awake > 0.0) {
-        values["ours2_over_this_ms_per_awake_step"] = Number(summary.ours2_over_this_awake);
-      }
+      AddRatioValues(summary, &values);
       if (!scene.articulations.empty()) {
         values["energy_drift"] = Number(result.energy_drift);
         values["energy_growth"] = Number(result.energy_growth);
