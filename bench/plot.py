@@ -5,9 +5,10 @@
 
 Left: ms per step, right: ms per awake step (the steps in which every body
 that can move is awake). One line per scene family (pile, pyramid) and
-engine, from the rows of the CSV that physics_bench writes; on the left the
-error bars span the min and max run. Points of scenes simulated for less
-than 10 s have open markers and a note.
+engine, each of ours apart ("ours", "ours x2", "ours soft_step", "ours
+soft_step x2"), from the rows of the CSV that physics_bench writes; on the
+left the error bars span the min and max run. Points of scenes simulated
+for less than 10 s have open markers and a note.
 """
 import csv
 import sys
@@ -16,6 +17,17 @@ import matplotlib
 
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
+
+
+def engine_label(row):
+    """The engine with, for ours, its solver and threads: each of ours is a
+    line of its own, not points of one line."""
+    label = row['engine']
+    if row.get('solver') == 'soft_step':
+        label += ' soft_step'
+    if row.get('threads') not in (None, '', '1'):
+        label += f" x{row['threads']}"
+    return label
 
 
 def main():
@@ -27,7 +39,7 @@ def main():
             family = row['scene'].split('_')[0]
             if family not in ('pile', 'pyramid') or not row['ms_per_step_median']:
                 continue
-            series.setdefault((family, row['engine']), []).append(
+            series.setdefault((family, engine_label(row)), []).append(
                 (int(row['bodies']), float(row['ms_per_step_median']),
                  float(row['ms_per_step_min']), float(row['ms_per_step_max']),
                  float(row['sim_seconds']),
@@ -37,7 +49,8 @@ def main():
 
     figure, (wall, awake) = plt.subplots(1, 2, figsize=(12, 5))
     styles = {'ours': ('tab:blue', 'o'), 'bullet': ('tab:orange', 's'),
-              'bullet_oursleep': ('tab:green', '^')}
+              'bullet_oursleep': ('tab:green', '^'), 'ours x2': ('tab:purple', 'D'),
+              'ours soft_step': ('tab:red', 'v'), 'ours soft_step x2': ('tab:brown', '<')}
     lines = {'pile': '-', 'pyramid': '--'}
     shortened = set()  # sim seconds of the shortened scenes
     for (family, engine), points in sorted(series.items()):
