@@ -53,12 +53,14 @@ struct SoftContactSolver::PairVelocities {
         v_b(b->linear_velocity),
         w_b(b->angular_velocity) {}
   // d.(v_a - v_b) + j_a.w_a - j_b.w_b: a row's velocity from its Jacobian.
-  double Along(const Vec3& d, const Vec3& j_a, const Vec3& j_b) const {
+  // Forced inline (GCC and Clang): called once per row update, an out-of-
+  // line call was a tenth of the soft step's time.
+  [[gnu::always_inline]] double Along(const Vec3& d, const Vec3& j_a, const Vec3& j_b) const {
     return d.dot(v_a - v_b) + j_a.dot(w_a) - j_b.dot(w_b);
   }
   // Impulse p on A and -p on B, whose angular parts I^-1 (r x p) are given.
-  void Apply(const Vec3& p, double inverse_mass_a, double inverse_mass_b, const Vec3& angular_a,
-             const Vec3& angular_b) {
+  [[gnu::always_inline]] void Apply(const Vec3& p, double inverse_mass_a, double inverse_mass_b,
+                                    const Vec3& angular_a, const Vec3& angular_b) {
     v_a += inverse_mass_a * p;
     w_a += angular_a;
     v_b -= inverse_mass_b * p;
@@ -91,6 +93,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   collision_velocity_threshold_ = input.collision_velocity_threshold;
   touch_tolerance_ = input.touch_tolerance;
   load_tracking_ = input.settings.load_tracking;
+  may_bounce_.store(false, std::memory_order_relaxed);
   moving_.clear();
   moving_mask_.assign(bodies->size(), 0);
   states_.resize(bodies->size());
@@ -147,7 +150,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
 // sub-steps), and its friction rows.
 void SoftContactSolver::Prepare(const SoftStepInput& input, const std::vector<SoftBody>& bodies,
                                 const SolverManifold& manifold, const FrictionAnchor& anchor,
-                                Constraint* constraint) const {
+                                Constraint* constraint) {
   Constraint& c = *constraint;
   const SoftBody& a = bodies[manifold.body_a];
   const SoftBody& b = bodies[manifold.body_b];
@@ -189,6 +192,9 @@ void SoftContactSolver::Prepare(const SoftStepInput& input, const std::vector<So
     // keeps the speed it closed at (the speculative row has slowed it).
     p.closed = from.carried_approach < 0.0;
     p.carried = p.closed;
+    if (from.carried_approach < -collision_velocity_threshold_) {
+      may_bounce_.store(true, std::memory_order_relaxed);
+    }
     p.approach_velocity = p.closed
                               ? from.carried_approach
                               : c.normal.dot(a.linear_velocity - b.linear_velocity) +
@@ -265,7 +271,11 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
     barrier->Wait();
     RunPass(Pass::kRelax, thread, threads, barrier);
   }
-  RunPass(Pass::kRestitution, thread, threads, barrier);
+  // Every thread reads the flag after the last relax pass's barrier, so all
+  // take the same branch.
+  if (may_bounce_.load(std::memory_order_relaxed)) {
+    RunPass(Pass::kRestitution, thread, threads, barrier);
+  }
 }
 
 void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier) {
@@ -384,6 +394,7 @@ void SoftContactSolver::Solve(Constraint* c, bool use_bias) {
       // follows the positions' update).
       p.closed = true;
       p.approach_velocity = vn;
+      if (vn < -collision_velocity_threshold_) may_bounce_.store(true, std::memory_order_relaxed);
     }
   }
   for (int i = 0; i < c->point_count; ++i) {

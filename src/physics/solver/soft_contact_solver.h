@@ -24,6 +24,7 @@
 #define RIGID_BODY_SIM_PHYSICS_SOLVER_SOFT_CONTACT_SOLVER_H_
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -153,7 +154,7 @@ class SoftContactSolver {
 
   void Prepare(const SoftStepInput& input, const std::vector<SoftBody>& bodies,
                const SolverManifold& manifold, const FrictionAnchor& anchor,
-               Constraint* constraint) const;
+               Constraint* constraint);
   void PrepareFriction(const SoftBody& a, const SoftBody& b, const SolverManifold& manifold,
                        const FrictionAnchor& anchor, double share, Constraint* constraint) const;
   // Stage `pass` on the constraints, colour after colour, the overflow
@@ -186,6 +187,10 @@ class SoftContactSolver {
   double collision_velocity_threshold_ = 0.0;
   double touch_tolerance_ = 0.0;
   double load_tracking_ = 0.0;
+  // Some point closed faster than the collision threshold this step (or
+  // carried such a closing over): the restitution pass has work. Written by
+  // any thread, only ever to true, and read after a barrier.
+  std::atomic<bool> may_bounce_{false};
 };
 
 }  // namespace rigid_body_sim::physics

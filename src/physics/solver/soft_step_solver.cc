@@ -31,11 +31,15 @@ class SoftStepSolver final : public MotionSolver {
  private:
   void SeedNewSupports(const StepContext& step);
   void LoadBodies(const StepContext& step);
-  void StoreVelocities();
+  void StoreVelocities(const StepContext& step);
+
+  // A chunk of the pool's per-body loops: a body costs tens of ns.
+  static constexpr std::size_t kBodiesPerChunk = 128;
 
   WorldImpl& world_;
   SoftContactSolver solver_;
   std::vector<SoftBody> bodies_;            // per body slot
+  std::vector<std::uint32_t> loaded_;       // the moving bodies of the last LoadBodies
   std::vector<FrictionAnchor> anchors_;     // per manifold
   std::vector<std::uint8_t> touches_link_;  // per body slot, Integrate's
 };
@@ -69,7 +73,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   for (std::size_t m = 0; m < w.rigid_pairs_.size(); ++m) {
     w.rigid_pairs_[m]->friction_anchor = anchors_[m];
   }
-  StoreVelocities();
+  StoreVelocities(step);
   w.DisableNonFiniteBodies();
   w.articulations_.Solve(step);
   w.ReportContacts(w.rigid_pairs_, step, /*impacts_only=*/false);
@@ -100,6 +104,9 @@ void SoftStepSolver::SeedNewSupports(const StepContext& step) {
 void SoftStepSolver::LoadBodies(const StepContext& step) {
   WorldImpl& w = world_;
   bodies_.resize(w.bodies_.size());
+  // Last step's moving bodies may sleep now: none keeps its flag.
+  for (const std::uint32_t i : loaded_) bodies_[i].moving = false;
+  loaded_ = w.moving_bodies_;
   for (const SolverManifold& manifold : w.solver_.manifolds()) {
     for (const std::uint32_t i : {manifold.body_a, manifold.body_b}) {
       bodies_[i] = SoftBody();
@@ -108,13 +115,14 @@ void SoftStepSolver::LoadBodies(const StepContext& step) {
     }
   }
   const double max_spin = w.settings_.max_turn_per_step / step.dt;
-  for (const std::uint32_t i : w.moving_bodies_) {
+  step.pool->ParallelFor(w.moving_bodies_.size(), kBodiesPerChunk, [&](std::size_t k) {
+    const std::uint32_t i = w.moving_bodies_[k];
     Body& body = w.bodies_[i];
     SoftBody& soft = bodies_[i];
     soft = SoftBody();
     soft.position = body.position;
     soft.orientation = body.orientation;
-    if (body.disabled) continue;
+    if (body.disabled) return;
     soft.linear_velocity = body.linear_velocity;
     soft.angular_velocity = body.angular_velocity;
     const double spin = soft.angular_velocity.norm();
@@ -127,18 +135,18 @@ void SoftStepSolver::LoadBodies(const StepContext& step) {
     soft.inverse_inertia_world = body.inverse_inertia_world;
     soft.reach = body.bounding_radius;
     soft.moving = true;
-  }
+  });
 }
 
 // The end velocities as momenta, P = M v and L = I_world w, still about the
 // start orientation: the pose is written by Integrate, after the
 // articulations' solve has had its say on the bodies that touch a link.
-void SoftStepSolver::StoreVelocities() {
+void SoftStepSolver::StoreVelocities(const StepContext& step) {
   WorldImpl& w = world_;
-  for (const std::uint32_t i : w.moving_bodies_) {
-    Body& body = w.bodies_[i];
-    const SoftBody& soft = bodies_[i];
-    if (!soft.moving) continue;
+  step.pool->ParallelFor(w.moving_bodies_.size(), kBodiesPerChunk, [&](std::size_t k) {
+    Body& body = w.bodies_[w.moving_bodies_[k]];
+    const SoftBody& soft = bodies_[w.moving_bodies_[k]];
+    if (!soft.moving) return;
     body.linear_momentum = body.mass * soft.linear_velocity;
     body.angular_momentum = AngularMomentum(body, soft.angular_velocity);
     body.start_linear_velocity = soft.linear_velocity;
@@ -146,7 +154,7 @@ void SoftStepSolver::StoreVelocities() {
     body.pseudo_linear_velocity.setZero();
     body.pseudo_angular_velocity.setZero();
     body.UpdateDerived();
-  }
+  });
 }
 
 // Each moving body takes the motion of its sub-steps. A body that touches a
@@ -163,10 +171,11 @@ void SoftStepSolver::Integrate(const StepContext& step) {
     touches_link_[pair->body_a] = 1;
     touches_link_[pair->body_b] = 1;
   }
-  for (const std::uint32_t i : w.moving_bodies_) {
+  step.pool->ParallelFor(w.moving_bodies_.size(), kBodiesPerChunk, [&](std::size_t k) {
+    const std::uint32_t i = w.moving_bodies_[k];
     Body& body = w.bodies_[i];
     const SoftBody& soft = bodies_[i];
-    if (!soft.moving || body.disabled) continue;
+    if (!soft.moving || body.disabled) return;
     const Vec3 angular_velocity = body.angular_velocity;
     Vec3 moved = soft.delta_position;
     Vec3 turn = Vec3::Zero();
@@ -185,7 +194,7 @@ void SoftStepSolver::Integrate(const StepContext& step) {
     body.angular_momentum = AngularMomentum(body, angular_velocity);
     body.UpdateDerived();
     body.travel += touches_link_[i] ? moved.norm() + angle * body.bounding_radius : soft.travel;
-  }
+  });
   w.DisableNonFiniteBodies();
   w.UpdateSleep(step);
 }
