@@ -17,6 +17,7 @@
 
 #include "physics/articulation/articulation_system.h"
 #include "physics/contact/contact_frame.h"
+#include "physics/dynamics/integrator.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -288,14 +289,9 @@ void ArticulationSystem::TakeLinkSolveVelocities(const StepContext& step) {
     // The velocities of the solve, before any restitution pass.
     const ArticulationSolver::BodySlot& solved =
         solved_bodies_.empty() ? slot_body : solved_bodies_[index];
-    const Mat3 rotation = body.orientation.toRotationMatrix();
-    auto momentum = [&](const Vec3& angular_velocity) -> Vec3 {
-      return rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
-             (rotation.transpose() * angular_velocity);
-    };
     const Vec3 linear_change = solved.linear_velocity - body.linear_velocity;
-    const Vec3 solved_momentum = momentum(solved.angular_velocity);
-    const Vec3 angular_momentum = momentum(slot_body.angular_velocity);
+    const Vec3 solved_momentum = AngularMomentumFor(body, solved.angular_velocity);
+    const Vec3 angular_momentum = AngularMomentumFor(body, slot_body.angular_velocity);
     // A change that resting forces can make within the step (at most the
     // collision threshold beyond what gravity gives) is a force over it:
     // the trapezoidal drift keeps it exact, as kinetic friction on a

@@ -99,6 +99,12 @@ Vec3 TurnBetween(const Quat& from, const Quat& to, const Vec3& guess) {
   return axis * (angle + turns * 2.0 * kPi);
 }
 
+Vec3 AngularMomentumFor(const Body& body, const Vec3& angular_velocity) {
+  const Mat3 rotation = body.orientation.toRotationMatrix();
+  return rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
+         (rotation.transpose() * angular_velocity);
+}
+
 void IntegrateForces(const Vec3& gravity, double dt, const std::vector<std::uint32_t>& moving,
                      std::vector<Body>* bodies) {
   assert(dt > 0.0);

@@ -47,6 +47,10 @@ struct BodyPath {
 // the rotation vector the angular velocity alone would give.
 Vec3 TurnBetween(const Quat& from, const Quat& to, const Vec3& guess);
 
+// L = I_world w, with I_world = R diag(I) R^T at the body's orientation:
+// the angular momentum that turns it at `angular_velocity`.
+Vec3 AngularMomentumFor(const Body& body, const Vec3& angular_velocity);
+
 // Kick: P += (F + M g) dt and L += tau dt for the awake bodies of `moving`, then
 // clears the force and torque accumulators. Records v before the kick for
 // the trapezoidal drift.

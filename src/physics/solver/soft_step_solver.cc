@@ -6,21 +6,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "physics/dynamics/integrator.h"
 #include "physics/solver/motion_solver.h"
 #include "physics/solver/soft_contact_solver.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
-namespace {
-
-// L = I_world w, with I_world = R diag(I) R^T at the body's orientation.
-Vec3 AngularMomentum(const Body& body, const Vec3& angular_velocity) {
-  const Mat3 rotation = body.orientation.toRotationMatrix();
-  return rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
-         (rotation.transpose() * angular_velocity);
-}
-
-}  // namespace
 
 class SoftStepSolver final : public MotionSolver {
  public:
@@ -148,7 +139,7 @@ void SoftStepSolver::StoreVelocities(const StepContext& step) {
     const SoftBody& soft = bodies_[w.moving_bodies_[k]];
     if (!soft.moving) return;
     body.linear_momentum = body.mass * soft.linear_velocity;
-    body.angular_momentum = AngularMomentum(body, soft.angular_velocity);
+    body.angular_momentum = AngularMomentumFor(body, soft.angular_velocity);
     body.start_linear_velocity = soft.linear_velocity;
     body.start_angular_momentum = body.angular_momentum;
     body.pseudo_linear_velocity.setZero();
@@ -191,7 +182,7 @@ void SoftStepSolver::Integrate(const StepContext& step) {
       body.orientation =
           (Quat(Eigen::AngleAxisd(angle, turn / angle)) * body.orientation).normalized();
     }
-    body.angular_momentum = AngularMomentum(body, angular_velocity);
+    body.angular_momentum = AngularMomentumFor(body, angular_velocity);
     body.UpdateDerived();
     body.travel += touches_link_[i] ? moved.norm() + angle * body.bounding_radius : soft.travel;
   });

@@ -49,9 +49,7 @@ void StoreVelocities(const std::vector<SolverBody>& solver_bodies,
     if (body.disabled) continue;
     const SolverBody& solver_body = solver_bodies[i];
     body.linear_momentum = body.mass * solver_body.linear_velocity;
-    const Mat3 rotation = body.orientation.toRotationMatrix();
-    body.angular_momentum = rotation * body.inverse_principal_moments.cwiseInverse().asDiagonal() *
-                            (rotation.transpose() * solver_body.angular_velocity);
+    body.angular_momentum = AngularMomentumFor(body, solver_body.angular_velocity);
     body.pseudo_linear_velocity = solver_body.pseudo_linear_velocity;
     body.pseudo_angular_velocity = solver_body.pseudo_angular_velocity;
     body.UpdateDerived();
