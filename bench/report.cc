@@ -283,6 +283,44 @@ const std::vector<std::string>& CsvColumns() {
   return kColumns;
 }
 
+// The columns of the scene's own figures: drift, apex, slide, joints, the
+// terrain's settling.
+void AddSceneValues(const Scene& scene, const RunResult& result,
+                    std::map<std::string, std::string>* values_out) {
+  std::map<std::string, std::string>& values = *values_out;
+  const Quality quality = SceneQuality(scene, result);
+  switch (scene.kind) {
+    case SceneKind::kPile:
+    case SceneKind::kPyramid:
+      values["top_drift_m"] = Number(result.drift);
+      break;
+    case SceneKind::kBounce:
+      values["bounce_apex_m"] = Number(result.apex);
+      values["bounce_apex_error"] = Number(quality.value);
+      break;
+    case SceneKind::kIncline:
+      values["incline_slide_m"] = Number(result.slide);
+      values["incline_error"] = Number(quality.value);
+      break;
+    case SceneKind::kLimpArm:
+    case SceneKind::kHeldArm:
+      values["joint_separation_m"] = Number(result.joint_separation);
+      break;
+    case SceneKind::kArmPush:
+      values["boxes_moved"] = Number(result.boxes_moved);
+      values["driven_joint_swept_rad"] = Number(result.driven_swept);
+      values["driven_joint_commanded_rad"] = Number(result.driven_commanded);
+      [[fallthrough]];
+    case SceneKind::kChain:
+      values["joint_separation_m"] = Number(result.joint_separation);
+      break;
+    case SceneKind::kTerrain:
+      values["terrain_settle_s"] = Number(result.settle_time);
+      values["terrain_below_surface"] = Number(result.below_surface);
+      break;
+  }
+}
+
 void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream& csv) {
   const std::vector<std::string>& columns = CsvColumns();
   for (std::size_t c = 0; c < columns.size(); ++c) csv << (c > 0 ? "," : "") << columns[c];
@@ -329,37 +367,7 @@ void WriteCsv(const std::vector<Scene>& scenes, const Rows& rows, std::ofstream&
         values["servo_error_rad"] = Number(result.servo_error);
         values["diverged_runs"] = std::to_string(summary.diverged_runs);
       }
-      const Quality quality = SceneQuality(scene, result);
-      switch (scene.kind) {
-        case SceneKind::kPile:
-        case SceneKind::kPyramid:
-          values["top_drift_m"] = Number(result.drift);
-          break;
-        case SceneKind::kBounce:
-          values["bounce_apex_m"] = Number(result.apex);
-          values["bounce_apex_error"] = Number(quality.value);
-          break;
-        case SceneKind::kIncline:
-          values["incline_slide_m"] = Number(result.slide);
-          values["incline_error"] = Number(quality.value);
-          break;
-        case SceneKind::kLimpArm:
-        case SceneKind::kHeldArm:
-          values["joint_separation_m"] = Number(result.joint_separation);
-          break;
-        case SceneKind::kArmPush:
-          values["boxes_moved"] = Number(result.boxes_moved);
-          values["driven_joint_swept_rad"] = Number(result.driven_swept);
-          values["driven_joint_commanded_rad"] = Number(result.driven_commanded);
-          [[fallthrough]];
-        case SceneKind::kChain:
-          values["joint_separation_m"] = Number(result.joint_separation);
-          break;
-        case SceneKind::kTerrain:
-          values["terrain_settle_s"] = Number(result.settle_time);
-          values["terrain_below_surface"] = Number(result.below_surface);
-          break;
-      }
+      AddSceneValues(scene, result, &values);
       WriteCsvLine(values, csv);
     }
   }
