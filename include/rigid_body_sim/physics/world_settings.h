@@ -81,11 +81,12 @@ struct SleepSettings {
 constexpr int kMaxThreads = 256;
 
 // The solver of the stages from velocities to positions (docs/design.md,
-// "Two solvers"). kExact: Baraff's classification of every contact, exact
-// collision impulses with restitution, resting contact for all contacts at
-// once, and the time of impact found; the default. kSoftStep: sub-steps with
-// one relaxed iteration of soft contacts each, colour by colour on every
-// thread (Catto 2024, "Solver2D"), for big scenes that want speed first.
+// "One step" and "The soft step"). kExact: Baraff's classification of every
+// contact, exact collision impulses with restitution, resting contact for
+// all contacts at once, and the time of impact found; the default.
+// kSoftStep: sub-steps with one relaxed iteration of soft contacts each,
+// colour by colour on every thread (Catto 2024, "Solver2D"), for big scenes
+// that want speed first.
 enum class MotionSolverKind : std::uint8_t { kExact, kSoftStep };
 
 // The soft step's settings (MotionSolverKind::kSoftStep).
@@ -148,7 +149,9 @@ struct WorldSettings {
   // The solver of the stages from velocities to positions (the contact
   // solve and the impacts); see MotionSolverKind.
   MotionSolverKind motion_solver = MotionSolverKind::kExact;
-  SolverSettings solver;       // kExact's; kSoftStep reads collision_velocity_threshold
+  // kExact's; kSoftStep reads collision_velocity_threshold and
+  // contact_tolerance.
+  SolverSettings solver;
   SoftStepSettings soft_step;  // kSoftStep's
   SleepSettings sleep;
 };
