@@ -32,6 +32,15 @@ WorldSettings SoftSettings(int threads = 1) {
   return settings;
 }
 
+// A 0.2 m box of `mass` resting on the ground z = 0, its centre at 0.1 m.
+BoxSpec RestingBox(double mass = 1.0) {
+  BoxSpec spec;
+  spec.size = Vec3(0.2, 0.2, 0.2);
+  spec.mass = mass;
+  spec.world_from_body = Translation(0.0, 0.0, 0.1);
+  return spec;
+}
+
 void StepFor(World* world, double seconds) {
   const int steps = static_cast<int>(std::lround(seconds / world->settings().time_step));
   for (int i = 0; i < steps; ++i) world->Step();
@@ -40,10 +49,7 @@ void StepFor(World* world, double seconds) {
 TEST(SoftStepTest, BoxRestsOnTheGroundCarryingItsWeight) {
   World world(SoftSettings());
   const BodyId ground = AddGround(&world, MakeMaterial(0.5, 0.0));
-  BoxSpec spec;
-  spec.size = Vec3(0.2, 0.2, 0.2);
-  spec.mass = 2.0;
-  spec.world_from_body = Translation(0.0, 0.0, 0.1);
+  const BoxSpec spec = RestingBox(2.0);
   const BodyId box = AddBox(&world, spec);
   // 0.3 s: settled, and still awake (sleep needs 0.5 s of rest).
   StepFor(&world, 0.3);
@@ -192,10 +198,7 @@ TEST(SoftStepTest, PyramidStands) {
 TEST(SoftStepTest, SleepingBoxIsUntouchedAndStillReported) {
   World world(SoftSettings());
   const BodyId ground = AddGround(&world, MakeMaterial(0.5, 0.0));
-  BoxSpec spec;
-  spec.size = Vec3(0.2, 0.2, 0.2);
-  spec.world_from_body = Translation(0.0, 0.0, 0.1);
-  const BodyId box = AddBox(&world, spec);
+  const BodyId box = AddBox(&world, RestingBox());
   StepFor(&world, 1.5);
   ASSERT_EQ(world.AwakeBodyCount(), 0u);
   const Body asleep = world.GetBody(box);
@@ -213,10 +216,7 @@ TEST(SoftStepTest, SwitchingSolversLeavesARestingBoxAtRest) {
   settings.sleep.enabled = false;
   World world(settings);
   AddGround(&world, MakeMaterial(0.5, 0.0));
-  BoxSpec spec;
-  spec.size = Vec3(0.2, 0.2, 0.2);
-  spec.world_from_body = Translation(0.0, 0.0, 0.1);
-  const BodyId box = AddBox(&world, spec);
+  const BodyId box = AddBox(&world, RestingBox());
   for (const MotionSolverKind solver :
        {MotionSolverKind::kExact, MotionSolverKind::kSoftStep, MotionSolverKind::kExact}) {
     settings.motion_solver = solver;

@@ -97,14 +97,20 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   moving_.clear();
   moving_mask_.assign(bodies->size(), 0);
   states_.resize(bodies->size());
-  for (std::uint32_t i = 0; i < bodies->size(); ++i) {
+  auto load = [&](std::uint32_t i) {
     const SoftBody& body = (*bodies)[i];
     states_[i] = State{body.linear_velocity, body.angular_velocity, Vec3::Zero(), Vec3::Zero(),
                        Quat::Identity()};
-    if (body.moving) {
-      moving_.push_back(i);
-      moving_mask_[i] = 1;
-    }
+  };
+  for (const std::uint32_t i : *input.moving) {
+    if (!(*bodies)[i].moving) continue;
+    moving_.push_back(i);
+    moving_mask_[i] = 1;
+    load(i);
+  }
+  for (const SolverManifold& manifold : *manifolds) {
+    if (!moving_mask_[manifold.body_a]) load(manifold.body_a);
+    if (!moving_mask_[manifold.body_b]) load(manifold.body_b);
   }
   anchors->resize(manifolds->size());
   body_a_.resize(manifolds->size());

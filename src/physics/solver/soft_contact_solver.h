@@ -62,6 +62,10 @@ struct SoftStepInput {
   SoftStepSettings settings;
   double collision_velocity_threshold = 0.0;  // m/s
   double touch_tolerance = 0.0;               // m: a point this close touches
+  // The bodies the step may move (those of them whose SoftBody::moving is
+  // set); with the manifolds' bodies, the only ones it reads, so bodies
+  // asleep and out of contact cost nothing.
+  const std::vector<std::uint32_t>* moving = nullptr;
 };
 
 class SoftContactSolver {

@@ -30,7 +30,6 @@ class SoftStepSolver final : public MotionSolver {
   WorldImpl& world_;
   SoftContactSolver solver_;
   std::vector<SoftBody> bodies_;            // per body slot
-  std::vector<std::uint32_t> loaded_;       // the moving bodies of the last LoadBodies
   std::vector<FrictionAnchor> anchors_;     // per manifold
   std::vector<std::uint8_t> touches_link_;  // per body slot, Integrate's
 };
@@ -54,6 +53,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   // A point a tenth of the contact margin apart touches: a face landing
   // flat stops on its first corners' speculative rows, the others a fraction
   // of a millimetre up.
+  input.moving = &w.moving_bodies_;
   input.touch_tolerance =
       std::max(w.settings_.solver.contact_tolerance, 0.1 * w.settings_.contact_margin);
   anchors_.resize(w.rigid_pairs_.size());
@@ -95,9 +95,6 @@ void SoftStepSolver::SeedNewSupports(const StepContext& step) {
 void SoftStepSolver::LoadBodies(const StepContext& step) {
   WorldImpl& w = world_;
   bodies_.resize(w.bodies_.size());
-  // Last step's moving bodies may sleep now: none keeps its flag.
-  for (const std::uint32_t i : loaded_) bodies_[i].moving = false;
-  loaded_ = w.moving_bodies_;
   for (const SolverManifold& manifold : w.solver_.manifolds()) {
     for (const std::uint32_t i : {manifold.body_a, manifold.body_b}) {
       bodies_[i] = SoftBody();
