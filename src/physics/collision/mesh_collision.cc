@@ -2,6 +2,7 @@
 #include "physics/collision/mesh_collision.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -321,6 +322,7 @@ class TriangleQuery {
         mesh_(*pair.mesh),
         mesh_from_convex_(pair.world_from_mesh.Inverse() * pair.world_from_convex),
         world_from_mesh_rotation_(pair.world_from_mesh.rotation.toRotationMatrix()),
+        polyhedron_(std::get_if<std::shared_ptr<const ConvexPolyhedron>>(pair.convex)),
         prism_geometry_(std::shared_ptr<const ConvexPolyhedron>(std::shared_ptr<void>(), &prism_)) {
     thread_local std::vector<int> found;
     const Aabb box = ShapeAabb(*pair.convex, mesh_from_convex_).Fattened(pair.contact_distance);
@@ -334,7 +336,8 @@ class TriangleQuery {
     const Vec3 local_center = ShapeCenter(*pair.convex);
     const Vec3 center_mesh = mesh_from_convex_ * local_center;
     depth_ = 2.0 * ShapeBoundingRadius(*pair.convex, local_center) + pair.contact_distance;
-    const Mat3 convex_from_mesh = mesh_from_convex_.rotation.conjugate().toRotationMatrix();
+    convex_from_mesh_ = mesh_from_convex_.rotation.conjugate().toRotationMatrix();
+    const Mat3& convex_from_mesh = convex_from_mesh_;
     for (const int t : found) {
       const CollisionMesh::Triangle& triangle = mesh_.triangles()[t];
       const double offset = triangle.normal.dot(mesh_.vertices()[triangle.vertices[0]]);
@@ -350,6 +353,11 @@ class TriangleQuery {
                            LowestAlong(*pair.convex, convex_from_mesh * normal) - plane;
       if (bound >= pair.contact_distance) {
         *gap = std::min(*gap, bound);
+        continue;
+      }
+      const double apart = FaceOfConvexSeparation(triangle, normal);
+      if (apart > pair.contact_distance) {
+        *gap = std::min(*gap, apart);
         continue;
       }
       candidates->push_back({t, bound, back});
@@ -395,6 +403,35 @@ class TriangleQuery {
   }
 
  private:
+  // The largest separation of the triangle's prism (front vertices v_k,
+  // normal n towards the shape, extruded by the depth d along -n) from the
+  // faces of a polyhedral shape, the first of the separating-axis test's
+  // axes: along a face (u, c) of the shape, the prism's least extent is
+  // min_k u.v_k + min(0, -d u.n), so s_u = c' - that, with the signs of the
+  // shape's outward normal, is s_u = min_k (u.v_k) + min(0, -d u.n) - c
+  // (Gottschalk, Lin and Manocha 1996, "OBBTree", section 4: the
+  // projection of a polytope on an axis is the interval of its vertices').
+  // One face beyond the contact distance settles the pair before the prism
+  // is built; -infinity for a shape that is not a polyhedron.
+  double FaceOfConvexSeparation(const CollisionMesh::Triangle& triangle,
+                                const Vec3& normal_mesh) const {
+    if (polyhedron_ == nullptr) return -std::numeric_limits<double>::infinity();
+    std::array<Vec3, 3> vertices;
+    for (int k = 0; k < 3; ++k) {
+      vertices[k] = Multiply(convex_from_mesh_, mesh_.vertices()[triangle.vertices[k]] -
+                                                    mesh_from_convex_.translation);
+    }
+    const Vec3 normal = Multiply(convex_from_mesh_, normal_mesh);
+    double largest = -std::numeric_limits<double>::infinity();
+    for (const ConvexPolyhedron::Face& face : (*polyhedron_)->faces) {
+      const double least = std::min({face.normal.dot(vertices[0]), face.normal.dot(vertices[1]),
+                                     face.normal.dot(vertices[2])}) +
+                           std::min(0.0, -depth_ * face.normal.dot(normal));
+      largest = std::max(largest, least - face.offset);
+    }
+    return largest;
+  }
+
   // The contact of the shape with the face of the prism last made (its
   // front triangle, normal n, offset d) alone, along n, for when the
   // prism's contact normal lies outside the touched feature's Voronoi
@@ -465,6 +502,8 @@ class TriangleQuery {
   const CollisionMesh& mesh_;
   const Pose mesh_from_convex_;
   const Mat3 world_from_mesh_rotation_;
+  const std::shared_ptr<const ConvexPolyhedron>* polyhedron_;  // null for other shapes
+  Mat3 convex_from_mesh_;
   double depth_ = 0.0;  // m, of the prisms
   ConvexPolyhedron prism_;
   // Lends prism_ to the narrow phase; owns nothing.

@@ -44,7 +44,7 @@ struct EdgeQuery {
 struct SatResult {
   FaceQuery face_a;  // best face of A: its outward normal points from A to B
   FaceQuery face_b;  // best face of B
-  EdgeQuery edges;   // best edge pair
+  EdgeQuery edges;   // best edge pair among those that may beat the faces (edge_a -1: none)
   double separation = -std::numeric_limits<double>::infinity();  // m, max of the three
   Vec3 normal_world = Vec3::UnitZ();  // unit, from B to A, the axis of `separation`
   SeparatingWitness witness;          // the feature of `separation`

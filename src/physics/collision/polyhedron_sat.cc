@@ -115,15 +115,37 @@ bool EdgeAxis(const PairInA& frame, const EdgeInA& edge_a, const EdgeInA& edge_b
   return true;
 }
 
+// Whether the pair's axis e_a x e_b can separate by more than `best`: the
+// separation along it is c.d / |c| with c = e_a x e_b (turned out of A) and
+// d = p_b - p_a, so with both sides squared no root is taken for the pairs
+// that lose by far, most of them once a face has touched. A pair is passed
+// on unless it loses by more than a relative 1e-9, so that EdgeAxis and the
+// separation, computed as before, decide every close call.
+bool MayBeatSeparation(const PairInA& frame, const EdgeInA& edge_a, const EdgeInA& edge_b,
+                       double best) {
+  const Vec3 cross = edge_a.direction.cross(edge_b.direction);
+  const double outward = cross.dot(edge_a.start - frame.a->centroid) < 0.0 ? -1.0 : 1.0;
+  const double projection = outward * cross.dot(edge_b.start - edge_a.start);
+  if (!(projection < 0.0) || !(best > -kInfinity)) return true;
+  // Both negative, s = projection / |c|: s < best iff projection^2 > best^2 |c|^2.
+  return !(best >= 0.0 ||
+           projection * projection > (1.0 + 1e-9) * best * best * cross.squaredNorm());
+}
+
 // Best edge pair over the Minkowski-face pairs. On such a pair the edges are
 // the supports of A along the axis and of B against it, so the separation is
-// axis.(p_b - p_a) with any points on the two edges.
-EdgeQuery QueryEdges(const PairInA& frame, double early_out) {
+// axis.(p_b - p_a) with any points on the two edges. The first Gauss-map
+// test (IsMinkowskiFace) reads each of B's face normals against an edge of
+// A's arc, so those products are taken once per edge of A, face by face.
+EdgeQuery QueryEdges(const PairInA& frame, double early_out, double best_face) {
   thread_local std::vector<EdgeInA> b_edges;
   thread_local std::vector<Vec3> b_arc_normals;
-  const int b_edge_count = frame.b->EdgeCount();
+  thread_local std::vector<double> b_face_sides;
+  const ConvexPolyhedron& b = *frame.b;
+  const int b_edge_count = b.EdgeCount();
   b_edges.resize(b_edge_count);
   b_arc_normals.resize(b_edge_count);
+  b_face_sides.resize(b.faces.size());
   for (int e = 0; e < b_edge_count; ++e) {
     b_edges[e] = EdgeOfB(frame, e);
     b_arc_normals[e] = b_edges[e].normal_right.cross(b_edges[e].normal_left);
@@ -133,10 +155,20 @@ EdgeQuery QueryEdges(const PairInA& frame, double early_out) {
   for (int ea = 0; ea < frame.a->EdgeCount(); ++ea) {
     const EdgeInA edge_a = EdgeOfA(frame, ea);
     const Vec3 bxa = edge_a.normal_right.cross(edge_a.normal_left);
+    for (std::size_t f = 0; f < b.faces.size(); ++f) {
+      b_face_sides[f] = -(*frame.b_normals)[f].dot(bxa);
+    }
     for (int eb = 0; eb < b_edge_count; ++eb) {
       const EdgeInA& edge_b = b_edges[eb];
+      // -n_c . (n_b x n_a) and -n_d . (n_b x n_a) of IsMinkowskiFace.
+      const double cba = b_face_sides[b.half_edges[2 * eb].face];
+      const double dba = b_face_sides[b.half_edges[2 * eb + 1].face];
+      if (!(cba * dba < 0.0)) continue;
       if (!IsMinkowskiFace(edge_a.normal_left, edge_a.normal_right, bxa, edge_b.normal_left,
                            edge_b.normal_right, b_arc_normals[eb])) {
+        continue;
+      }
+      if (!MayBeatSeparation(frame, edge_a, edge_b, std::max(best_face, query.separation))) {
         continue;
       }
       Vec3 axis;
@@ -256,7 +288,7 @@ SatResult RunSat(const PairInA& frame, double early_out) {
     result.normal_world = frame.world_from_a.rotation * (*frame.b_normals)[result.face_b.face];
   }
   if (result.separation > early_out) return result;
-  result.edges = QueryEdges(frame, early_out);
+  result.edges = QueryEdges(frame, early_out, result.separation);
   if (result.edges.separation > result.separation) {
     result.separation = result.edges.separation;
     result.witness = {SeparatingWitness::Type::kEdges, result.edges.edge_a, result.edges.edge_b};
