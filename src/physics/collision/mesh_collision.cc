@@ -406,13 +406,14 @@ class TriangleQuery {
   // The largest separation of the triangle's prism (front vertices v_k,
   // normal n towards the shape, extruded by the depth d along -n) from the
   // faces of a polyhedral shape, the first of the separating-axis test's
-  // axes: along a face (u, c) of the shape, the prism's least extent is
-  // min_k u.v_k + min(0, -d u.n), so s_u = c' - that, with the signs of the
-  // shape's outward normal, is s_u = min_k (u.v_k) + min(0, -d u.n) - c
-  // (Gottschalk, Lin and Manocha 1996, "OBBTree", section 4: the
-  // projection of a polytope on an axis is the interval of its vertices').
-  // One face beyond the contact distance settles the pair before the prism
-  // is built; -infinity for a shape that is not a polyhedron.
+  // axes. The shape lies at u.x <= c below a face (u outward, plane
+  // u.x = c), and the prism's least extent along u is that of its six
+  // vertices, min_k u.v_k + min(0, -d u.n), so the gap along u is
+  // s_u = min_k u.v_k + min(0, -d u.n) - c (Gottschalk, Lin and Manocha
+  // 1996, "OBBTree", section 4: a polytope projects on an axis to the
+  // interval of its vertices). One face beyond the contact distance settles
+  // the pair before the prism is built; -infinity for a shape that is not a
+  // polyhedron.
   double FaceOfConvexSeparation(const CollisionMesh::Triangle& triangle,
                                 const Vec3& normal_mesh) const {
     if (polyhedron_ == nullptr) return -std::numeric_limits<double>::infinity();
