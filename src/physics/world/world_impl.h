@@ -204,7 +204,6 @@ class WorldImpl : public LinkBodies {
   std::vector<Vec3> push_normals_;            // HoldPushedBodies' scratch, per body slot
   std::vector<std::uint8_t> push_state_;      // 0 not pushed, 1 along one normal, 2 several
   std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
-  std::vector<Pose> start_poses_;             // world_from_principal at the start of the step
   std::vector<SleepWindow> sleep_windows_;    // the sleep test's, per body slot (UpdateSleep)
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
