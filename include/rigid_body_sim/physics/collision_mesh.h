@@ -25,8 +25,8 @@ class WideBoxTree;
 
 class CollisionMesh {
  public:
-  // Most triangles a mesh may have (16 Mi): its tree and adjacency then take
-  // a few GB at most.
+  // Most triangles a mesh may have (16 Mi): its tree, adjacency and ray
+  // records (about 300 bytes a triangle) then take 5 GB at most.
   static constexpr std::size_t kMaxTriangles = std::size_t{1} << 24;
 
   enum class EdgeFold : std::uint8_t { kFlat, kConvex, kConcave, kBoundary };
@@ -54,6 +54,21 @@ class CollisionMesh {
   const std::vector<Vec3>& vertices() const { return vertices_; }
   // In tree order (leaves hold consecutive triangles), not the input order.
   const std::vector<Triangle>& triangles() const { return triangles_; }
+
+  // What a ray test reads of a triangle: its first vertex and its edges to
+  // the second and the third, as triangles() winds them.
+  struct RayTriangle {
+    Vec3 corner;             // m, vertices[0]
+    Vec3 edge1;              // m, vertices[1] - vertices[0]
+    Vec3 edge2;              // m, vertices[2] - vertices[0]
+    Vec3 normal;             // Triangle::normal
+    bool two_sided = false;  // Triangle::two_sided
+  };
+  // In triangles()' order, so that a leaf's triangles are one stretch of
+  // 104-byte records: a ray read a 128-byte Triangle and then its three
+  // vertices, one dependent load after another (100,000 rays on a 99k-
+  // triangle terrain and 1,000 boxes, one thread: 66 -> 60 ms).
+  const std::vector<RayTriangle>& ray_triangles() const { return ray_triangles_; }
   // The tree of the triangles' boxes (physics/geometry/wide_box_tree.h):
   // leaf items are triangle indices.
   const WideBoxTree& tree() const { return *tree_; }
@@ -80,6 +95,7 @@ class CollisionMesh {
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
+  std::vector<RayTriangle> ray_triangles_;
   std::shared_ptr<const WideBoxTree> tree_;
   double radius_about_origin_ = 0.0;  // m
 };

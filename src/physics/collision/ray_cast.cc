@@ -33,12 +33,10 @@ Ray ToShape(const Pose& world_from_shape, const Ray& ray) {
 
 // Moller and Trumbore 1997, "Fast, Minimum Storage Ray/Triangle
 // Intersection", section 2: o + t d = (1 - u - v) v0 + u v1 + v v2 solved
-// by Cramer's rule with the triple products. Edges count as inside, so a
-// ray through an edge two triangles share hits one of them. Returns t, or
-// +infinity.
-double RayTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2) {
-  const Vec3 e1 = v1 - v0;
-  const Vec3 e2 = v2 - v0;
+// by Cramer's rule with the triple products, e1 = v1 - v0 and e2 = v2 - v0.
+// Edges count as inside, so a ray through an edge two triangles share hits
+// one of them. Returns t, or +infinity.
+double RayTriangle(const Ray& ray, const Vec3& v0, const Vec3& e1, const Vec3& e2) {
   const Vec3 p = ray.direction.cross(e2);
   const double det = e1.dot(p);
   if (det == 0.0) return kInfinity;  // parallel to the plane
@@ -56,11 +54,9 @@ double RayTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v
 // Triangle `index` of the mesh against the ray, if it faces it (a closed
 // component's triangles only from their outer side): t or +infinity.
 double RayMeshTriangle(const CollisionMesh& mesh, int index, const Ray& ray) {
-  const CollisionMesh::Triangle& triangle = mesh.triangles()[index];
+  const CollisionMesh::RayTriangle& triangle = mesh.ray_triangles()[index];
   if (!triangle.two_sided && triangle.normal.dot(ray.direction) >= 0.0) return kInfinity;
-  const std::vector<Vec3>& vertices = mesh.vertices();
-  return RayTriangle(ray, vertices[triangle.vertices[0]], vertices[triangle.vertices[1]],
-                     vertices[triangle.vertices[2]]);
+  return RayTriangle(ray, triangle.corner, triangle.edge1, triangle.edge2);
 }
 
 // A hit at t on triangle i before the best so far (ties go to the lower
@@ -72,7 +68,7 @@ bool Nearer(double t, int i, double best, int best_triangle) {
 
 RayHit MeshHit(const CollisionMesh& mesh, const Ray& ray, double t, int triangle) {
   if (triangle < 0) return RayHit{};
-  const Vec3& normal = mesh.triangles()[triangle].normal;
+  const Vec3& normal = mesh.ray_triangles()[triangle].normal;
   return MakeHit(ray, t, normal.dot(ray.direction) < 0.0 ? normal : Vec3(-normal));
 }
 

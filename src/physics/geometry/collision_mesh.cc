@@ -202,6 +202,13 @@ void CollisionMesh::BuildTree() {
   std::vector<Triangle> sorted(triangles_.size());
   for (std::size_t i = 0; i < sorted.size(); ++i) sorted[i] = triangles_[order[i]];
   triangles_.swap(sorted);
+  ray_triangles_.resize(triangles_.size());
+  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    const auto& v = triangles_[t].vertices;
+    ray_triangles_[t] = {vertices_[v[0]], vertices_[v[1]] - vertices_[v[0]],
+                         vertices_[v[2]] - vertices_[v[0]], triangles_[t].normal,
+                         triangles_[t].two_sided};
+  }
   double radius_squared = 0.0;
   for (const Vec3& vertex : vertices_)
     radius_squared = std::max(radius_squared, vertex.squaredNorm());
