@@ -22,11 +22,10 @@ RayHit MakeHit(const Ray& ray, double t, const Vec3& normal) {
 }
 
 // The ray in a shape's frame (a pose keeps lengths, so t is the same).
-Ray ToShape(const Pose& world_from_shape, const Ray& ray) {
-  const Quat shape_from_world = world_from_shape.rotation.conjugate();
+Ray ToShape(const ShapeFrame& frame, const Ray& ray) {
   Ray local;
-  local.origin = shape_from_world * (ray.origin - world_from_shape.translation);
-  local.direction = shape_from_world * ray.direction;
+  local.origin = frame.shape_from_world * (ray.origin - frame.translation);
+  local.direction = frame.shape_from_world * ray.direction;
   local.max_distance = ray.max_distance;
   return local;
 }
@@ -214,7 +213,11 @@ RayHit RayCastMeshBruteForce(const CollisionMesh& mesh, const Ray& ray) {
 }
 
 RayHit RayCastShape(const ShapeGeometry& geometry, const Pose& world_from_shape, const Ray& ray) {
-  const Ray local = ToShape(world_from_shape, ray);
+  return RayCastShape(geometry, ShapeFrame(world_from_shape), ray);
+}
+
+RayHit RayCastShape(const ShapeGeometry& geometry, const ShapeFrame& frame, const Ray& ray) {
+  const Ray local = ToShape(frame, ray);
   RayHit hit = std::visit(
       [&local](const auto& shape) -> RayHit {
         using T = std::decay_t<decltype(shape)>;
@@ -233,7 +236,7 @@ RayHit RayCastShape(const ShapeGeometry& geometry, const Pose& world_from_shape,
       geometry);
   if (!hit.hit) return hit;
   hit.point = ray.origin + hit.distance * ray.direction;
-  hit.normal = world_from_shape.rotation * hit.normal;
+  hit.normal = frame.shape_from_world.transpose() * hit.normal;
   return hit;
 }
 

@@ -16,7 +16,22 @@
 
 namespace rigid_body_sim::physics {
 
+// A shape's pose with its rotation as a matrix, made once for the many rays
+// of a batch: each ray is turned into the shape and each hit's normal out
+// by a matrix product, cheaper than the quaternion's (ray_bench's 100,000
+// rays, one thread: 50.4 -> 47.7 ms). The two round differently, by a few
+// units in the last place.
+struct ShapeFrame {
+  ShapeFrame() = default;
+  explicit ShapeFrame(const Pose& world_from_shape)
+      : shape_from_world(world_from_shape.rotation.conjugate().toRotationMatrix()),
+        translation(world_from_shape.translation) {}
+  Mat3 shape_from_world = Mat3::Identity();
+  Vec3 translation = Vec3::Zero();  // m, the shape's origin in the world
+};
+
 // The ray, given in the frame the shape is posed in, against one shape.
+RayHit RayCastShape(const ShapeGeometry& geometry, const ShapeFrame& frame, const Ray& ray);
 RayHit RayCastShape(const ShapeGeometry& geometry, const Pose& world_from_shape, const Ray& ray);
 
 // Shape-frame casts, each for a ray in the shape's own frame.

@@ -29,7 +29,7 @@ constexpr double kUnitTolerance = 1e-9;
 struct ShapeEntry {
   std::uint32_t body = 0;
   int shape = 0;
-  Pose world_from_shape;
+  ShapeFrame frame;  // the shape's pose in the world
   Aabb box;
 };
 
@@ -74,7 +74,7 @@ void Consider(const ShapeEntry& entry, const ShapeGeometry& geometry, const Ray&
               const std::vector<Body>& bodies, RayHit* best) {
   Ray shortened = ray;
   shortened.max_distance = std::min(ray.max_distance, best->distance);
-  RayHit hit = RayCastShape(geometry, entry.world_from_shape, shortened);
+  RayHit hit = RayCastShape(geometry, entry.frame, shortened);
   if (!hit.hit || (best->hit && hit.distance >= best->distance)) return;
   hit.body = BodyId{entry.body, bodies[entry.body].generation};
   hit.shape = entry.shape;
@@ -221,13 +221,13 @@ Result<std::vector<RayHit>> WorldImpl::CastRays(const std::vector<Ray>& rays,
       const ShapeGeometry& geometry = body.shapes[s].geometry;
       // A static mesh's extra contact slots are copies of its first.
       if (const auto* mesh = std::get_if<StaticMesh>(&geometry); mesh && mesh->slot != 0) continue;
-      ShapeEntry entry{b, static_cast<int>(s), world_from_body * body.shapes[s].body_from_shape,
-                       Aabb{}};
+      const Pose world_from_shape = world_from_body * body.shapes[s].body_from_shape;
+      ShapeEntry entry{b, static_cast<int>(s), ShapeFrame(world_from_shape), Aabb{}};
       if (std::holds_alternative<HalfSpace>(geometry)) {
         apart.push_back(entry);
         continue;
       }
-      entry.box = ShapeAabb(geometry, entry.world_from_shape);
+      entry.box = ShapeAabb(geometry, world_from_shape);
       tree.entries.push_back(entry);
     }
   }
