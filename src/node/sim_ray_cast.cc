@@ -2,6 +2,7 @@
 // shapes (physics::World::CastRays), answered in the same frame.
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -17,6 +18,39 @@ namespace rigid_body_sim::node {
 using physics::Pose;
 using physics::Result;
 using physics::Status;
+
+namespace {
+
+// Each shape's frame name is looked up once per request: most of a large
+// batch hits a few shapes (a laser's room, a terrain). A hit on the shape
+// of the hit before it (most of them, on a terrain) takes the name from
+// there without the table.
+void FillHitFrames(const std::vector<physics::RayHit>& hits, const ModelRegistry& registry,
+                   const std::optional<physics::BodyId>& ground,
+                   std::vector<std::string>* hit_frames) {
+  std::unordered_map<std::uint64_t, std::string> frames;
+  hit_frames->resize(hits.size());
+  std::uint64_t last_key = 0;
+  const std::string* last = nullptr;
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    if (!hits[i].hit) continue;
+    const std::uint64_t key =
+        std::uint64_t{hits[i].body.index} << 32 | static_cast<std::uint32_t>(hits[i].shape);
+    if (last == nullptr || key != last_key) {
+      auto [frame, added] = frames.try_emplace(key);
+      if (added) {
+        frame->second = ground && hits[i].body == *ground
+                            ? std::string(names::kGroundName)
+                            : registry.ShapeFrame(hits[i].body, hits[i].shape);
+      }
+      last_key = key;
+      last = &frame->second;
+    }
+    (*hit_frames)[i] = *last;
+  }
+}
+
+}  // namespace
 
 bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
                         rigid_body_sim::RayCast::Response& response) {
@@ -49,29 +83,18 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
       }
       ignore.insert(ignore.end(), model->bodies.begin(), model->bodies.end());
     }
-    for (physics::Ray& ray : world_rays) {
-      ray.origin = world_from_frame * ray.origin;
-      ray.direction = world_from_frame.rotation * ray.direction;
+    // Rays in the world frame are cast as they came, not turned by the
+    // identity.
+    if (!request.frame_id.empty()) {
+      for (physics::Ray& ray : world_rays) {
+        ray.origin = world_from_frame * ray.origin;
+        ray.direction = world_from_frame.rotation * ray.direction;
+      }
     }
     Result<std::vector<physics::RayHit>> cast = world_.CastRays(world_rays, ignore);
     if (!cast.ok()) return Fail(response, cast.message(), names::kRayCastService);
     hits = std::move(cast).value();
-    // Each shape's frame name is looked up once per request: most of a
-    // large batch hits a few shapes (a laser's room, a terrain).
-    std::unordered_map<std::uint64_t, std::string> frames;
-    response.hit_frames.resize(hits.size());
-    for (std::size_t i = 0; i < hits.size(); ++i) {
-      if (!hits[i].hit) continue;
-      const std::uint64_t key =
-          std::uint64_t{hits[i].body.index} << 32 | static_cast<std::uint32_t>(hits[i].shape);
-      auto [frame, added] = frames.try_emplace(key);
-      if (added) {
-        frame->second = ground_ && hits[i].body == *ground_
-                            ? std::string(names::kGroundName)
-                            : registry_.ShapeFrame(hits[i].body, hits[i].shape);
-      }
-      response.hit_frames[i] = frame->second;
-    }
+    FillHitFrames(hits, registry_, ground_, &response.hit_frames);
   }
   const Pose frame_from_world = world_from_frame.Inverse();
   response.hit.resize(hits.size());
@@ -82,8 +105,13 @@ bool SimNode::OnRayCast(rigid_body_sim::RayCast::Request& request,
     response.hit[i] = hits[i].hit;
     response.distance[i] = hits[i].distance;
     if (!hits[i].hit) continue;
-    response.points[i] = PointToMsg(frame_from_world * hits[i].point);
-    response.normals[i] = VectorToMsg(frame_from_world.rotation * hits[i].normal);
+    if (request.frame_id.empty()) {
+      response.points[i] = PointToMsg(hits[i].point);
+      response.normals[i] = VectorToMsg(hits[i].normal);
+    } else {
+      response.points[i] = PointToMsg(frame_from_world * hits[i].point);
+      response.normals[i] = VectorToMsg(frame_from_world.rotation * hits[i].normal);
+    }
   }
   response.success = true;
   return true;
