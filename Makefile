@@ -202,7 +202,9 @@ bench: deps
 	@if [ -x $(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node ]; then \
 	  source $(WS)/devel/setup.bash && \
 	  python3 $(ROOT)/bench/spawn_bench.py --csv $(ROOT)/bench/results/latest.csv && \
-	  python3 $(ROOT)/bench/ray_service_bench.py; \
+	  python3 $(ROOT)/bench/ray_service_bench.py && \
+	  $(CATKIN) ray_service_client -j$(JOBS) > /dev/null && \
+	  python3 $(ROOT)/bench/ray_service_bench.py --client $(WS)/devel/lib/rigid_body_sim/ray_service_client; \
 	else echo "spawn: node not built ($(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node; make build)"; fi
 	$(BENCH_BUILD)/narrow_phase_bench 200000
 	$(BENCH_BUILD)/broad_phase_bench 30

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Time of one ~ray_cast call of 100,000 rays through the running node.
 
-  bench/ray_service_bench.py [--rays N] [--calls N]
+  bench/ray_service_bench.py [--rays N] [--calls N] [--client PATH]
 
 ray_bench's scene through the node's public interface: a static terrain of
 99,458 triangles (100 m square, 0.5 m waves, written as an OBJ file), 1,000
@@ -11,12 +11,18 @@ with sim.launch (one physics thread, ~threads' default), and prints the
 best round trip, what this Python client spends encoding the request and
 decoding the answer (genpy, measured apart on the same messages), and the
 rest: the node's own time and the transport.
+
+With --client, the C++ client bench/ray_service_client.cc (built by `make
+bench`) runs instead, under the same master and node: it spawns ray_bench's
+own scene and rays, so that the round trip is timed without genpy's
+decoding, and checks the first hits against the exact ones.
 """
 import argparse
 import io
 import math
 import os
 import random
+import subprocess
 import tempfile
 import time
 
@@ -87,7 +93,12 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument('--rays', type=int, default=100000)
     parser.add_argument('--calls', type=int, default=5)
+    parser.add_argument('--client', help='the C++ client (ray_service_client) to run instead')
     args = parser.parse_args()
+    if args.client:
+        with NodeSession('ray_service_bench'):
+            result = subprocess.run([args.client, str(args.rays), str(args.calls)])
+        raise SystemExit(result.returncode)
     with NodeSession('ray_service_bench') as rospy:
         from rigid_body_sim.srv import RayCast, RayCastResponse
         with tempfile.TemporaryDirectory() as scratch:
