@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -12,6 +15,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
+
+#include "io/text_mesh_reader.h"
 
 namespace rigid_body_sim::io {
 namespace {
@@ -99,6 +104,41 @@ void CollectNode(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
   }
 }
 
+// An OBJ or ASCII STL file read in double precision (ReadObjText,
+// ReadAsciiStlText), or nullopt for assimp to read. A binary STL is known by
+// its size, 84 bytes and 50 per facet, whatever its header says.
+std::optional<TriangleMesh> ReadTextMesh(const std::string& path, const std::string& extension,
+                                         std::uintmax_t size) {
+  if (extension != ".obj" && extension != ".stl") return std::nullopt;
+  std::ifstream file(path, std::ios::binary);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (!file.read(text.data(), static_cast<std::streamsize>(text.size()))) return std::nullopt;
+  if (extension == ".obj") return ReadObjText(text);
+  if (size >= 84) {
+    std::uint32_t facets = 0;
+    std::memcpy(&facets, text.data() + 80, sizeof(facets));
+    if (size == 84 + 50 * static_cast<std::uintmax_t>(facets)) return std::nullopt;
+  }
+  return ReadAsciiStlText(text);
+}
+
+// The scale, the orientation under a mirroring scale and the joined
+// vertices, as for a mesh that assimp read.
+Result<TriangleMesh> FinishTextMesh(const std::string& path, const Vec3& scale, TriangleMesh mesh) {
+  for (Vec3& vertex : mesh.vertices) {
+    vertex = vertex.cwiseProduct(scale);
+    if (!vertex.allFinite()) {
+      return Result<TriangleMesh>::Error("mesh file '" + path +
+                                         "' has a vertex that is not finite");
+    }
+  }
+  if (scale.prod() < 0.0) {
+    for (Eigen::Vector3i& triangle : mesh.triangles) std::swap(triangle[1], triangle[2]);
+  }
+  JoinIdenticalVertices(&mesh);
+  return mesh;
+}
+
 }  // namespace
 
 Result<std::string> ResolveFileUri(const std::string& uri) {
@@ -142,6 +182,10 @@ Result<TriangleMesh> LoadMesh(const std::string& uri, const Vec3& scale,
     return Result<TriangleMesh>::Error("mesh file '" + path + "' size " + std::to_string(size) +
                                        " bytes is above the limit " +
                                        std::to_string(max_file_bytes));
+  }
+
+  if (std::optional<TriangleMesh> text = ReadTextMesh(path, extension, size)) {
+    return FinishTextMesh(path, scale, std::move(*text));
   }
 
   Assimp::Importer importer;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -143,6 +144,59 @@ TEST(MeshLoaderTest, BadFilesAreRefusedNamingTheFile) {
   const Result<TriangleMesh> flat = LoadMesh(kDataDir + "/chamfered_box.obj", Vec3(1.0, 0.0, 1.0));
   ASSERT_FALSE(flat.ok());
   EXPECT_NE(flat.message().find("scale"), std::string::npos) << flat.message();
+}
+
+std::string WriteFile(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// Assimp keeps coordinates as float; OBJ and ASCII STL are read as written,
+// to the nearest double, so a terrain's ray hits and contacts can be checked
+// against the file's own numbers.
+TEST(MeshLoaderTest, TextMeshesKeepTheirDecimalsToTheDouble) {
+  const std::vector<Vec3> written = {Vec3(0.1, -2.7182818284590451, 0.30000001),
+                                     Vec3(10.000000001, 0.2, -0.3), Vec3(1e-9, 3.3, 7.123456789)};
+  ASSERT_NE(static_cast<double>(static_cast<float>(written[0].x())), written[0].x());
+  const std::string decimals[3] = {"0.1 -2.7182818284590451 0.30000001", "10.000000001 0.2 -0.3",
+                                   "1e-9 3.3 7.123456789"};
+  const std::string obj =
+      WriteFile("decimals.obj", "# one triangle\nv " + decimals[0] + "\nv " + decimals[1] + "\nv " +
+                                    decimals[2] + "\nvt 0 0\nvn 0 0 1\ng part\nf 1/1/1 2//1 -1\n");
+  const std::string stl =
+      WriteFile("decimals.stl", "solid t\n facet normal 0 0 1\n  outer loop\n   vertex " +
+                                    decimals[0] + "\n   vertex " + decimals[1] + "\n   vertex " +
+                                    decimals[2] + "\n  endloop\n endfacet\nendsolid t\n");
+  for (const std::string& path : {obj, stl}) {
+    SCOPED_TRACE(path);
+    const Result<TriangleMesh> mesh = LoadMesh(path);
+    ASSERT_TRUE(mesh.ok()) << mesh.message();
+    ASSERT_EQ(mesh->vertices.size(), 3u);
+    ASSERT_EQ(mesh->triangles.size(), 1u);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(mesh->vertices[mesh->triangles[0][k]], written[k]) << "corner " << k;
+    }
+  }
+}
+
+// Polygons become fans from their first corner, points and lines go, and
+// vertices no face uses are dropped, as assimp's triangulation does.
+TEST(MeshLoaderTest, ObjPolygonsBecomeFansOverTheVerticesTheyUse) {
+  const std::string path = WriteFile("polygons.obj",
+                                     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nv 0 0 1\n"
+                                     "f 1 2 3 4\nl 1 5\np 5\nf -6 -3 -1\n");
+  const Result<TriangleMesh> mesh = LoadMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  EXPECT_EQ(mesh->vertices.size(), 5u);  // (5, 5, 5) only in a line and a point
+  ASSERT_EQ(mesh->triangles.size(), 3u);
+  double area_z = 0.0;  // of the unit square's two triangles, both facing +z
+  for (int t = 0; t < 2; ++t) {
+    const Eigen::Vector3i& tri = mesh->triangles[t];
+    const Vec3& a = mesh->vertices[tri[0]];
+    area_z += 0.5 * (mesh->vertices[tri[1]] - a).cross(mesh->vertices[tri[2]] - a).z();
+  }
+  EXPECT_DOUBLE_EQ(area_z, 1.0);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// Triangle meshes from mesh files (STL, OBJ, DAE, PLY) through assimp.
+// Triangle meshes from mesh files (STL, OBJ, DAE, PLY) through assimp; OBJ
+// and ASCII STL are read in double precision first.
 #ifndef RIGID_BODY_SIM_IO_MESH_LOADER_H_
 #define RIGID_BODY_SIM_IO_MESH_LOADER_H_
 
@@ -23,7 +24,10 @@ physics::Result<std::string> ResolveFileUri(const std::string& uri);
 
 // Loads every sub-mesh of a mesh file, places it with its node transforms,
 // applies `scale` (per axis, dimensionless) and joins identical vertices.
-// Supported: .stl (ASCII and binary), .obj, .dae, .ply. A DAE file's
+// Supported: .stl (ASCII and binary), .obj, .dae, .ply. OBJ and ASCII STL
+// coordinates are the nearest doubles to the file's decimals (assimp's are
+// floats: 0.1 would come back 1.5e-9 off); a file of those formats that the
+// double-precision reader does not know is left to assimp. A DAE file's
 // <unit meter> and <up_axis> are honoured: the result is in metres with +z up.
 // Triangles keep the file's orientation (corrected for a mirroring scale);
 // no closedness is required.
