@@ -94,8 +94,8 @@ Scene MakeScene(int ray_count) {
 // The terrain as a binary STL file (Burns 1989, the StereoLithography
 // Interface Specification: an 80-byte header, a 32-bit count, then per
 // triangle a normal and three corners in 32-bit floats and a 16-bit
-// attribute), whose floats the node's loader reads as they are: an OBJ
-// file's decimals went through its single-precision parser, 2e-7 m off.
+// attribute), whose floats the node's loader reads as they are, in a file a
+// fifth of an OBJ's size.
 bool WriteStl(const Scene& scene, const std::string& path) {
   std::ofstream out(path, std::ios::binary);
   const char header[80] = "ray_service_client terrain";
