@@ -20,9 +20,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
-#include <random>
 #include <vector>
 
+#include "ray_scene.h"
 #include "rigid_body_sim/physics/collision_mesh.h"
 #include "rigid_body_sim/physics/convex_polyhedron.h"
 #include "rigid_body_sim/physics/mass_properties.h"
@@ -31,51 +31,28 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-constexpr int kCells = 223;      // terrain cells per side: 2 * 223^2 triangles
-constexpr double kSize = 100.0;  // m, terrain side
-constexpr int kBoxes = 1000;
-constexpr double kBox = 0.5;  // m, box edge
-constexpr double kMaxDistance = 100.0;
-
-double Height(double x, double y) { return 0.5 * std::sin(0.3 * x) * std::cos(0.2 * y); }
-
-TriangleMesh Terrain() {
-  TriangleMesh mesh;
-  for (int i = 0; i <= kCells; ++i) {
-    for (int j = 0; j <= kCells; ++j) {
-      const double x = kSize * i / kCells - kSize / 2;
-      const double y = kSize * j / kCells - kSize / 2;
-      mesh.vertices.emplace_back(x, y, Height(x, y));
-    }
-  }
-  const auto index = [](int i, int j) { return i * (kCells + 1) + j; };
-  for (int i = 0; i < kCells; ++i) {
-    for (int j = 0; j < kCells; ++j) {
-      mesh.triangles.emplace_back(index(i, j), index(i + 1, j), index(i + 1, j + 1));
-      mesh.triangles.emplace_back(index(i, j), index(i + 1, j + 1), index(i, j + 1));
-    }
-  }
-  return mesh;
-}
+using bench::kRayBox;
+using bench::kRayBoxes;
+using bench::kRayReach;
 
 struct Scene {
   TriangleMesh terrain;
   std::vector<Vec3> box_centres;
   std::vector<Ray> rays;
+  bench::RayScene shared;  // the same, for ExactRayDistance
 };
 
 Scene MakeScene(int ray_count) {
   Scene scene;
-  scene.terrain = Terrain();
-  std::mt19937 random(3);
-  std::uniform_real_distribution<double> place(-40.0, 40.0);
-  for (int i = 0; i < kBoxes; ++i)
-    scene.box_centres.emplace_back(place(random), place(random), 1.5);
-  for (int k = 0; k < ray_count; ++k) {
+  scene.shared = bench::MakeRayScene(ray_count, false);
+  scene.terrain.vertices = scene.shared.vertices;
+  scene.terrain.triangles = scene.shared.triangles;
+  scene.box_centres = scene.shared.box_centres;
+  for (const bench::SceneRay& shared : scene.shared.rays) {
     Ray ray;
-    ray.origin = Vec3(place(random), place(random), 3.0);
-    ray.direction = Vec3(place(random), place(random), -40.0).normalized();
-    ray.max_distance = kMaxDistance;
+    ray.origin = shared.origin;
+    ray.direction = shared.direction;
+    ray.max_distance = kRayReach;
     scene.rays.push_back(ray);
   }
   return scene;
@@ -92,11 +69,11 @@ World MakeOurWorld(const Scene& scene, int threads) {
   ground.shapes.push_back(mesh);
   world.CreateBody(ground).value();
   const auto box =
-      std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3::Constant(kBox)));
+      std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(Vec3::Constant(kRayBox)));
   for (const Vec3& centre : scene.box_centres) {
     BodyDef def;
     def.world_from_body.translation = centre;
-    def.mass_properties = BoxMassProperties(1000.0, Vec3::Constant(kBox));
+    def.mass_properties = BoxMassProperties(1000.0, Vec3::Constant(kRayBox));
     ShapeDef shape;
     shape.geometry = box;
     def.shapes.push_back(shape);
@@ -145,51 +122,11 @@ std::unique_ptr<BulletScene> MakeBulletScene(const Scene& scene) {
   };
   add(bullet->terrain.get(), Vec3::Zero());
   // Bullet's margin rounds a box's edges; 0 keeps its faces where ours are.
-  bullet->box = std::make_unique<btBoxShape>(btVector3(kBox / 2, kBox / 2, kBox / 2));
+  bullet->box = std::make_unique<btBoxShape>(btVector3(kRayBox / 2, kRayBox / 2, kRayBox / 2));
   bullet->box->setMargin(0.0);
   for (const Vec3& centre : scene.box_centres) add(bullet->box.get(), centre);
   bullet->world->updateAabbs();
   return bullet;
-}
-
-// The exact first hit: the boxes (axis-aligned) by their slabs, the
-// terrain by every triangle (Moller and Trumbore 1997, written here apart
-// from the engine's); -1 for none.
-double ExactDistance(const Scene& scene, const Ray& ray) {
-  double best = ray.max_distance;
-  bool hit = false;
-  for (const Vec3& centre : scene.box_centres) {
-    double enter = 0.0;
-    double exit = ray.max_distance;
-    for (int axis = 0; axis < 3; ++axis) {
-      const double low = (centre[axis] - kBox / 2 - ray.origin[axis]) / ray.direction[axis];
-      const double high = (centre[axis] + kBox / 2 - ray.origin[axis]) / ray.direction[axis];
-      enter = std::max(enter, std::min(low, high));
-      exit = std::min(exit, std::max(low, high));
-    }
-    if (enter <= exit && enter <= best) {
-      best = enter;
-      hit = true;
-    }
-  }
-  for (const Eigen::Vector3i& triangle : scene.terrain.triangles) {
-    const Vec3& a = scene.terrain.vertices[triangle[0]];
-    const Vec3 e1 = scene.terrain.vertices[triangle[1]] - a;
-    const Vec3 e2 = scene.terrain.vertices[triangle[2]] - a;
-    const Vec3 p = ray.direction.cross(e2);
-    const double det = e1.dot(p);
-    if (det == 0.0) continue;
-    const Vec3 s = ray.origin - a;
-    const double u = s.dot(p) / det;
-    const Vec3 q = s.cross(e1);
-    const double v = ray.direction.dot(q) / det;
-    const double t = e2.dot(q) / det;
-    if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t >= 0.0 && t <= best) {
-      best = t;
-      hit = true;
-    }
-  }
-  return hit ? best : -1.0;
 }
 
 struct Accuracy {
@@ -205,7 +142,7 @@ Accuracy Compare(const Scene& scene, const std::vector<RayHit>& ours,
   Accuracy accuracy;
   accuracy.rays = static_cast<int>(std::min<std::size_t>(1000, scene.rays.size()));
   for (int i = 0; i < accuracy.rays; ++i) {
-    const double exact = ExactDistance(scene, scene.rays[i]);
+    const double exact = bench::ExactRayDistance(scene.shared, scene.shared.rays[i], false);
     const auto score = [exact](bool hit, double distance, int* disagree, double* error) {
       if (hit != (exact >= 0.0)) {
         ++*disagree;
@@ -255,7 +192,7 @@ double TimeBullet(const BulletScene& bullet, const Scene& scene, std::vector<dou
 int Run(int ray_count) {
   const Scene scene = MakeScene(ray_count);
   std::printf("[ray] %d rays, %d boxes, %zu terrain triangles (best of 3 runs)\n", ray_count,
-              kBoxes, scene.terrain.triangles.size());
+              kRayBoxes, scene.terrain.triangles.size());
   const std::unique_ptr<BulletScene> bullet = MakeBulletScene(scene);
   std::vector<double> bullet_distances;
   const double bullet_time = TimeBullet(*bullet, scene, &bullet_distances);

@@ -25,10 +25,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <random>
 #include <string>
 #include <vector>
 
+#include "ray_scene.h"
 #include "rigid_body_sim/RayCast.h"
 #include "rigid_body_sim/Spawn.h"
 
@@ -36,60 +36,13 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-// ray_bench.cc's scene, drawn from the same generator in the same order.
-constexpr int kCells = 223;      // terrain cells per side: 2 * 223^2 triangles
-constexpr double kSize = 100.0;  // m, terrain side
-constexpr int kBoxes = 1000;
-constexpr double kBox = 0.5;  // m, box edge
-constexpr double kMaxDistance = 100.0;
+using rigid_body_sim::bench::kRayBoxes;
+using rigid_body_sim::bench::kRayReach;
+using Scene = rigid_body_sim::bench::RayScene;
+using Ray = rigid_body_sim::bench::SceneRay;
+
 constexpr double kTolerance = 1e-9;  // m, the acceptance's
 constexpr char kNode[] = "/rigid_body_sim";
-
-double Height(double x, double y) { return 0.5 * std::sin(0.3 * x) * std::cos(0.2 * y); }
-
-struct Ray {
-  Vec3 origin;
-  Vec3 direction;  // unit
-};
-
-struct Scene {
-  std::vector<Vec3> vertices;
-  std::vector<Eigen::Vector3i> triangles;
-  std::vector<Vec3> box_centres;
-  std::vector<Ray> rays;
-};
-
-Scene MakeScene(int ray_count) {
-  Scene scene;
-  for (int i = 0; i <= kCells; ++i) {
-    for (int j = 0; j <= kCells; ++j) {
-      const double x = kSize * i / kCells - kSize / 2;
-      const double y = kSize * j / kCells - kSize / 2;
-      // In single precision, as the STL file holds them.
-      scene.vertices.push_back(Vec3(x, y, Height(x, y)).cast<float>().cast<double>());
-    }
-  }
-  const auto index = [](int i, int j) { return i * (kCells + 1) + j; };
-  for (int i = 0; i < kCells; ++i) {
-    for (int j = 0; j < kCells; ++j) {
-      scene.triangles.emplace_back(index(i, j), index(i + 1, j), index(i + 1, j + 1));
-      scene.triangles.emplace_back(index(i, j), index(i + 1, j + 1), index(i, j + 1));
-    }
-  }
-  // Written as ray_bench writes them: the order in which one call's two
-  // draws are made is the compiler's, the same in both.
-  std::mt19937 random(3);
-  std::uniform_real_distribution<double> place(-40.0, 40.0);
-  for (int i = 0; i < kBoxes; ++i)
-    scene.box_centres.emplace_back(place(random), place(random), 1.5);
-  for (int k = 0; k < ray_count; ++k) {
-    Ray ray;
-    ray.origin = Vec3(place(random), place(random), 3.0);
-    ray.direction = Vec3(place(random), place(random), -40.0).normalized();
-    scene.rays.push_back(ray);
-  }
-  return scene;
-}
 
 // The terrain as a binary STL file (Burns 1989, the StereoLithography
 // Interface Specification: an 80-byte header, a 32-bit count, then per
@@ -149,50 +102,10 @@ bool SpawnScene(ros::NodeHandle& node, const Scene& scene, const std::string& me
   const std::string box =
       "<robot name=\"box\"><link name=\"box\"><collision><geometry><box size=\"0.5 0.5 0.5\"/>"
       "</geometry></collision></link></robot>";
-  for (int k = 0; k < kBoxes; ++k) {
+  for (int k = 0; k < kRayBoxes; ++k) {
     if (!Spawn(spawn, "box_" + std::to_string(k), box, scene.box_centres[k])) return false;
   }
   return true;
-}
-
-// The exact first hit: the boxes (axis-aligned) by their slabs, the terrain
-// by every triangle (Moller and Trumbore 1997), the ground plane z = 0 from
-// above; -1 for none.
-double ExactDistance(const Scene& scene, const Ray& ray, const std::vector<Vec3>& vertices) {
-  double best = kMaxDistance;
-  bool hit = false;
-  const auto take = [&](double t) {
-    if (t >= 0.0 && t <= best) {
-      best = t;
-      hit = true;
-    }
-  };
-  for (const Vec3& centre : scene.box_centres) {
-    double enter = 0.0;
-    double exit = kMaxDistance;
-    for (int axis = 0; axis < 3; ++axis) {
-      const double low = (centre[axis] - kBox / 2 - ray.origin[axis]) / ray.direction[axis];
-      const double high = (centre[axis] + kBox / 2 - ray.origin[axis]) / ray.direction[axis];
-      enter = std::max(enter, std::min(low, high));
-      exit = std::min(exit, std::max(low, high));
-    }
-    if (enter <= exit) take(enter);
-  }
-  for (const Eigen::Vector3i& triangle : scene.triangles) {
-    const Vec3& a = vertices[triangle[0]];
-    const Vec3 e1 = vertices[triangle[1]] - a;
-    const Vec3 e2 = vertices[triangle[2]] - a;
-    const Vec3 p = ray.direction.cross(e2);
-    const double det = e1.dot(p);
-    if (det == 0.0) continue;
-    const Vec3 s = ray.origin - a;
-    const double u = s.dot(p) / det;
-    const Vec3 q = s.cross(e1);
-    const double v = ray.direction.dot(q) / det;
-    if (u >= 0.0 && v >= 0.0 && u + v <= 1.0) take(e2.dot(q) / det);
-  }
-  if (ray.origin.z() >= 0.0 && ray.direction.z() < 0.0) take(-ray.origin.z() / ray.direction.z());
-  return hit ? best : -1.0;
 }
 
 double Seconds(std::chrono::steady_clock::time_point start) {
@@ -218,15 +131,15 @@ void ClientShare(const rigid_body_sim::RayCast& call, double* encode, double* de
   }
 }
 
-// The largest difference of the first `checked` answers from ExactDistance
-// on the terrain's `vertices`, in distance or point (m); -1 when a hit and a
-// miss differ.
-double LargestError(const Scene& scene, const std::vector<Vec3>& vertices,
-                    const rigid_body_sim::RayCast::Response& answer, int checked) {
+// The largest difference of the first `checked` answers from the exact first
+// hits (ExactRayDistance, the ground plane included), in distance or point
+// (m); -1 when a hit and a miss differ.
+double LargestError(const Scene& scene, const rigid_body_sim::RayCast::Response& answer,
+                    int checked) {
   double error = 0.0;
   for (int i = 0; i < checked; ++i) {
     const Ray& ray = scene.rays[i];
-    const double exact = ExactDistance(scene, ray, vertices);
+    const double exact = rigid_body_sim::bench::ExactRayDistance(scene, ray, true);
     if (answer.hit[i] != (exact >= 0.0)) return -1.0;
     if (!answer.hit[i]) continue;
     const Vec3 point(answer.points[i].x, answer.points[i].y, answer.points[i].z);
@@ -240,7 +153,7 @@ double LargestError(const Scene& scene, const std::vector<Vec3>& vertices,
 // is off by more than kTolerance, or a hit and a miss differ.
 bool Check(const Scene& scene, const rigid_body_sim::RayCast::Response& answer, int checked) {
   checked = std::min<int>(checked, scene.rays.size());
-  const double error = LargestError(scene, scene.vertices, answer, checked);
+  const double error = LargestError(scene, answer, checked);
   std::printf(
       "  the first %d hits against the exact ones (boxes by slabs, every triangle, the "
       "ground): largest error %.1e m (-1: a hit and a miss differ)\n",
@@ -249,7 +162,7 @@ bool Check(const Scene& scene, const rigid_body_sim::RayCast::Response& answer, 
 }
 
 int Run(ros::NodeHandle& node, int ray_count, int calls, int checked) {
-  const Scene scene = MakeScene(ray_count);
+  const Scene scene = rigid_body_sim::bench::MakeRayScene(ray_count, true);
   char directory[] = "/tmp/ray_service_client_XXXXXX";
   if (mkdtemp(directory) == nullptr) return 1;
   const std::string stl_path = std::string(directory) + "/terrain.stl";
@@ -258,7 +171,7 @@ int Run(ros::NodeHandle& node, int ray_count, int calls, int checked) {
   std::remove(directory);
   if (!spawned) return 1;
   rigid_body_sim::RayCast call;
-  call.request.max_distance = kMaxDistance;
+  call.request.max_distance = kRayReach;
   for (const Ray& ray : scene.rays) {
     geometry_msgs::Point origin;
     origin.x = ray.origin.x();
