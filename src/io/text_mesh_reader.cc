@@ -55,6 +55,27 @@ bool ParseCorner(std::string_view token, long count, long* index) {
   return *index >= 0 && *index < count;
 }
 
+// Whether the polygon of `corners` is convex, so that a fan from its first
+// corner covers it: every turn e_i x e_(i+1) along it has a non-negative
+// component along its normal (Newell's, Sutherland, Sproull and Schumacker
+// 1974, "A Characterization of Ten Hidden-Surface Algorithms", ACM
+// Computing Surveys 6(1)). A concave face is left to assimp, which clips its
+// ears.
+bool IsConvexPolygon(const std::vector<Vec3>& vertices, const std::vector<long>& corners) {
+  const std::size_t n = corners.size();
+  Vec3 normal = Vec3::Zero();
+  for (std::size_t k = 0; k < n; ++k) {
+    normal += vertices[corners[k]].cross(vertices[corners[(k + 1) % n]]);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3& a = vertices[corners[k]];
+    const Vec3& b = vertices[corners[(k + 1) % n]];
+    const Vec3& c = vertices[corners[(k + 2) % n]];
+    if ((b - a).cross(c - b).dot(normal) < 0.0) return false;
+  }
+  return true;
+}
+
 // Keeps the vertices the triangles use, in file order.
 TriangleMesh Compact(std::vector<Vec3> vertices, std::vector<Eigen::Vector3i> triangles) {
   std::vector<int> new_index(vertices.size(), -1);
@@ -108,6 +129,7 @@ std::optional<TriangleMesh> ReadObjText(const std::string& text) {
         if (!ParseCorner(token, count, &index)) return false;
         corners.push_back(index);
       }
+      if (corners.size() > 3 && !IsConvexPolygon(vertices, corners)) return false;
       for (std::size_t k = 2; k < corners.size(); ++k) {
         triangles.emplace_back(static_cast<int>(corners[0]), static_cast<int>(corners[k - 1]),
                                static_cast<int>(corners[k]));

@@ -12,11 +12,11 @@
 
 namespace rigid_body_sim::io {
 
-// The triangles of an OBJ file's faces (polygons as fans from their first
-// corner, points and lines dropped) over the vertices they use, in file
-// order; nullopt when the text is not an OBJ this reader knows (then assimp
-// reads it). Faces index with 1-based or negative (relative) numbers, with
-// or without /vt/vn parts; other statements are ignored.
+// The triangles of an OBJ file's faces (convex polygons as fans from their
+// first corner, points and lines dropped) over the vertices they use, in
+// file order; nullopt when the text is not an OBJ this reader knows, or has
+// a concave face (then assimp reads it). Faces index with 1-based or negative (relative) numbers,
+// with or without /vt/vn parts; other statements are ignored.
 std::optional<physics::TriangleMesh> ReadObjText(const std::string& text);
 
 // The facets of an ASCII STL file ("solid ... facet ... outer loop, three

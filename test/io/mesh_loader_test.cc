@@ -199,5 +199,24 @@ TEST(MeshLoaderTest, ObjPolygonsBecomeFansOverTheVerticesTheyUse) {
   EXPECT_DOUBLE_EQ(area_z, 1.0);
 }
 
+// An L-shaped face listed from a reflex corner: a fan from there would
+// reach outside it, so the file is left to assimp's ear clipping, and the
+// triangles cover the L (area 3) once.
+TEST(MeshLoaderTest, ConcaveObjFaceIsCoveredOnce) {
+  const std::string path = WriteFile(
+      "l_shape.obj", "v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nf 1 2 3 4 5 6\n");
+  const Result<TriangleMesh> mesh = LoadMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  ASSERT_EQ(mesh->triangles.size(), 4u);
+  double area = 0.0;
+  for (const Eigen::Vector3i& tri : mesh->triangles) {
+    const Vec3& a = mesh->vertices[tri[0]];
+    const Vec3 normal = (mesh->vertices[tri[1]] - a).cross(mesh->vertices[tri[2]] - a);
+    EXPECT_GE(normal.z(), 0.0);
+    area += 0.5 * normal.norm();
+  }
+  EXPECT_NEAR(area, 3.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::io
