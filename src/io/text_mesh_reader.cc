@@ -37,10 +37,15 @@ bool ParseDouble(std::string_view token, double* value) {
   return error == std::errc() && end == token.data() + token.size();
 }
 
-bool ParseVertex(std::string_view* rest, Vec3* vertex) {
+// The vertex of a "v" or "vertex" line's first three numbers, appended;
+// false for a bad number or one vertex too many.
+bool AppendVertex(std::string_view* rest, std::vector<Vec3>* vertices) {
+  Vec3 vertex;
   for (int k = 0; k < 3; ++k) {
-    if (!ParseDouble(NextToken(rest), &(*vertex)[k])) return false;
+    if (!ParseDouble(NextToken(rest), &vertex[k])) return false;
   }
+  if (vertices->size() >= kMaxVertices) return false;
+  vertices->push_back(vertex);
   return true;
 }
 
@@ -118,9 +123,7 @@ std::optional<TriangleMesh> ReadObjText(const std::string& text) {
     std::string_view rest = line;
     const std::string_view keyword = NextToken(&rest);
     if (keyword == "v") {
-      Vec3 vertex;
-      if (!ParseVertex(&rest, &vertex) || vertices.size() >= kMaxVertices) return false;
-      vertices.push_back(vertex);
+      if (!AppendVertex(&rest, &vertices)) return false;
     } else if (keyword == "f") {
       corners.clear();
       const long count = static_cast<long>(vertices.size());
@@ -153,9 +156,7 @@ std::optional<TriangleMesh> ReadAsciiStlText(const std::string& text) {
     std::string_view rest = line;
     const std::string_view keyword = NextToken(&rest);
     if (keyword == "vertex") {
-      Vec3 vertex;
-      if (!ParseVertex(&rest, &vertex) || vertices.size() >= kMaxVertices) return false;
-      vertices.push_back(vertex);
+      if (!AppendVertex(&rest, &vertices)) return false;
     } else if (keyword == "endsolid") {
       ended = true;
     } else if (line.find('\0') != std::string_view::npos) {
@@ -164,11 +165,14 @@ std::optional<TriangleMesh> ReadAsciiStlText(const std::string& text) {
     return true;
   });
   if (!read || !ended || vertices.empty() || vertices.size() % 3 != 0) return std::nullopt;
-  std::vector<Eigen::Vector3i> triangles;
+  // Every vertex is a facet's corner: nothing to compact.
+  TriangleMesh mesh;
   for (std::size_t i = 0; i < vertices.size(); i += 3) {
-    triangles.emplace_back(static_cast<int>(i), static_cast<int>(i + 1), static_cast<int>(i + 2));
+    mesh.triangles.emplace_back(static_cast<int>(i), static_cast<int>(i + 1),
+                                static_cast<int>(i + 2));
   }
-  return Compact(std::move(vertices), std::move(triangles));
+  mesh.vertices = std::move(vertices);
+  return mesh;
 }
 
 }  // namespace rigid_body_sim::io

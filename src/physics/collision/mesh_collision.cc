@@ -337,7 +337,6 @@ class TriangleQuery {
     const Vec3 center_mesh = mesh_from_convex_ * local_center;
     depth_ = 2.0 * ShapeBoundingRadius(*pair.convex, local_center) + pair.contact_distance;
     convex_from_mesh_ = mesh_from_convex_.rotation.conjugate().toRotationMatrix();
-    const Mat3& convex_from_mesh = convex_from_mesh_;
     for (const int t : found) {
       const CollisionMesh::Triangle& triangle = mesh_.triangles()[t];
       const double offset = triangle.normal.dot(mesh_.vertices()[triangle.vertices[0]]);
@@ -350,7 +349,7 @@ class TriangleQuery {
       // In front of the plane by the contact distance (the plane's distance
       // bounds the triangle's): no contact.
       const double bound = normal.dot(mesh_from_convex_.translation) +
-                           LowestAlong(*pair.convex, convex_from_mesh * normal) - plane;
+                           LowestAlong(*pair.convex, convex_from_mesh_ * normal) - plane;
       if (bound >= pair.contact_distance) {
         *gap = std::min(*gap, bound);
         continue;

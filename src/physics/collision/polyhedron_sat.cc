@@ -69,15 +69,19 @@ FaceQuery QueryFacesOfB(const PairInA& frame, double early_out) {
 // opposite sides of the plane of arc a, na and nb on opposite sides of the
 // plane of arc b, and the crossing is the same point, not its antipode:
 //   (-nc.bxa)(-nd.bxa) < 0,  (na.dxc)(nb.dxc) < 0,  (-nc.bxa)(nb.dxc) > 0.
-bool IsMinkowskiFace(const Vec3& na, const Vec3& nb, const Vec3& bxa, const Vec3& nc,
-                     const Vec3& nd, const Vec3& dxc) {
-  // Most pairs fail the first test; the rest is computed only when needed.
-  const double cba = -nc.dot(bxa);
-  const double dba = -nd.dot(bxa);
+// The last two tests, given the first's products cba = -nc.bxa and
+// dba = -nd.bxa, which QueryEdges takes once per edge of A and face of B.
+bool ArcsCross(double cba, double dba, const Vec3& na, const Vec3& nb, const Vec3& dxc) {
   if (!(cba * dba < 0.0)) return false;
   const double adc = na.dot(dxc);
   const double bdc = nb.dot(dxc);
   return adc * bdc < 0.0 && cba * bdc > 0.0;
+}
+
+bool IsMinkowskiFace(const Vec3& na, const Vec3& nb, const Vec3& bxa, const Vec3& nc,
+                     const Vec3& nd, const Vec3& dxc) {
+  // Most pairs fail the first test; the rest is computed only when needed.
+  return ArcsCross(-nc.dot(bxa), -nd.dot(bxa), na, nb, dxc);
 }
 
 struct EdgeInA {
@@ -163,9 +167,7 @@ EdgeQuery QueryEdges(const PairInA& frame, double early_out, double best_face) {
       // -n_c . (n_b x n_a) and -n_d . (n_b x n_a) of IsMinkowskiFace.
       const double cba = b_face_sides[b.half_edges[2 * eb].face];
       const double dba = b_face_sides[b.half_edges[2 * eb + 1].face];
-      if (!(cba * dba < 0.0)) continue;
-      if (!IsMinkowskiFace(edge_a.normal_left, edge_a.normal_right, bxa, edge_b.normal_left,
-                           edge_b.normal_right, b_arc_normals[eb])) {
+      if (!ArcsCross(cba, dba, edge_a.normal_left, edge_a.normal_right, b_arc_normals[eb])) {
         continue;
       }
       if (!MayBeatSeparation(frame, edge_a, edge_b, std::max(best_face, query.separation))) {
