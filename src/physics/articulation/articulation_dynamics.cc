@@ -313,61 +313,25 @@ void ComputeDynamics(const ArticulationModel& model, const ArticulationState& st
 ArticulationState Advance(const ArticulationModel& model, const ArticulationState& state,
                           const Eigen::VectorXd& u, double h) {
   ArticulationState next = state;
+  AdvanceInto(model, state, u, h, &next);
   next.u = u;
+  return next;
+}
+
+void AdvanceInto(const ArticulationModel& model, const ArticulationState& state,
+                 const Eigen::VectorXd& u, double h, ArticulationState* out) {
+  out->base_com = state.base_com;
+  out->base_rotation = state.base_rotation;
   if (model.base_dofs == 6) {
-    next.base_com += h * u.head<3>();
+    out->base_com += h * u.head<3>();
     const Vec3 turn = h * u.segment<3>(3);
     const double angle = turn.norm();
     if (angle > 0.0) {
-      next.base_rotation =
+      out->base_rotation =
           (Quat(Eigen::AngleAxisd(angle, turn / angle)) * state.base_rotation).normalized();
     }
   }
-  next.q += h * u.tail(model.joint_dofs);
-  return next;
-}
-
-namespace {
-
-// The time derivative of the state: (u, M^-1 Q). The base orientation's
-// derivative is carried as omega and applied by Advance.
-Eigen::VectorXd Acceleration(const ArticulationModel& model, const ArticulationState& state,
-                             const Vec3& gravity, const Eigen::VectorXd& joint_efforts) {
-  thread_local ArticulationKinematics kinematics;
-  thread_local ArticulatedBodyScratch scratch;
-  ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
-  Eigen::VectorXd acceleration;
-  ForwardDynamics({model, state, kinematics, gravity, joint_efforts}, &scratch, &acceleration);
-  return acceleration;
-}
-
-}  // namespace
-
-// Classical RK4 (Kutta 1901; Hairer, Norsett and Wanner 1993, "Solving
-// Ordinary Differential Equations I", section II.1): k1..k4 at t, t + h/2,
-// t + h/2, t + h, combined as (k1 + 2 k2 + 2 k3 + k4) / 6. The base
-// orientation takes the weighted mean angular velocity as one turn, which
-// keeps it a unit quaternion.
-ArticulationState StepFreeMotion(const ArticulationModel& model, const ArticulationState& state,
-                                 const Vec3& gravity, const Eigen::VectorXd& joint_efforts,
-                                 double dt, const Eigen::VectorXd* start_acceleration) {
-  const Eigen::VectorXd& u1 = state.u;
-  const Eigen::VectorXd a1 = start_acceleration != nullptr
-                                 ? *start_acceleration
-                                 : Acceleration(model, state, gravity, joint_efforts);
-  ArticulationState s2 = Advance(model, state, u1, 0.5 * dt);
-  s2.u = u1 + 0.5 * dt * a1;
-  const Eigen::VectorXd a2 = Acceleration(model, s2, gravity, joint_efforts);
-  ArticulationState s3 = Advance(model, state, s2.u, 0.5 * dt);
-  s3.u = u1 + 0.5 * dt * a2;
-  const Eigen::VectorXd a3 = Acceleration(model, s3, gravity, joint_efforts);
-  ArticulationState s4 = Advance(model, state, s3.u, dt);
-  s4.u = u1 + dt * a3;
-  const Eigen::VectorXd a4 = Acceleration(model, s4, gravity, joint_efforts);
-  const Eigen::VectorXd mean_velocity = (u1 + 2.0 * s2.u + 2.0 * s3.u + s4.u) / 6.0;
-  ArticulationState next = Advance(model, state, mean_velocity, dt);
-  next.u = u1 + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
-  return next;
+  out->q = state.q + h * u.tail(model.joint_dofs);
 }
 
 }  // namespace rigid_body_sim::physics

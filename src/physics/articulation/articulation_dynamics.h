@@ -182,38 +182,11 @@ void ForwardDynamics(const ForwardDynamicsInput& in, ArticulatedBodyScratch* scr
 // base by h v and a turn of h omega.
 ArticulationState Advance(const ArticulationModel& model, const ArticulationState& state,
                           const Eigen::VectorXd& u, double h);
-
-// One step of the unconstrained motion by classical Runge-Kutta (fourth
-// order) on (q, u), efforts held constant over the step. `start_acceleration`,
-// when given, is u' at `state` (the first stage's, computed already).
-ArticulationState StepFreeMotion(const ArticulationModel& model, const ArticulationState& state,
-                                 const Vec3& gravity, const Eigen::VectorXd& joint_efforts,
-                                 double dt, const Eigen::VectorXd* start_acceleration = nullptr);
-
-// One free step's inputs.
-struct FreeMotionStep {
-  const ArticulationModel& model;
-  const ArticulationState& state;
-  const Vec3& gravity;                   // m/s^2
-  const Eigen::VectorXd& joint_efforts;  // per dof, N m or N
-  double dt;                             // s
-  // u' at `state` with the damping explicit, when the caller has it: the
-  // first RK4 stage then reuses it instead of computing it again.
-  const Eigen::VectorXd* start_acceleration = nullptr;
-};
-
-// How an articulation's free steps are split, kept from step to step.
-constexpr int kMaxFreeMotionParts = 64;
-struct FreeMotionSplit {
-  int parts = 1;           // RK4 steps per step, 1 to kMaxFreeMotionParts
-  int steps_at_parts = 0;  // steps taken since `parts` last changed
-};
-
-// One step of the unconstrained motion by RK4, split into as many equal
-// parts as keep E1 <= E0 + W (the efforts' work) to a tolerance of 1e-8 of
-// the kinetic energy; a gain left below it is projected away by scaling u.
-// Without external wrenches on the links the step never gains energy.
-ArticulationState StepFreeMotionBalanced(const FreeMotionStep& step, FreeMotionSplit* split);
+// The same positions written into `out` (its u is left as it was), without
+// allocating once `out` has the state's size. `u` may be out->u; `out` must
+// not be `state`.
+void AdvanceInto(const ArticulationModel& model, const ArticulationState& state,
+                 const Eigen::VectorXd& u, double h, ArticulationState* out);
 
 }  // namespace rigid_body_sim::physics
 

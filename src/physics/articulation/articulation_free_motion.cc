@@ -1,5 +1,5 @@
 // The free motion's step with its energy balance checked (docs/design.md,
-// "Articulated bodies", "Free motion that never gains energy").
+// "Articulated bodies", "Free motion that keeps its energy").
 //
 // Classical RK4 is stable only while dt omega < 2.78 for every mode of the
 // linearized motion (Hairer and Wanner 1996, "Solving Ordinary Differential
@@ -7,25 +7,29 @@
 // a heavy tip has modes near omega = 2 sqrt(T / (m l)): 1,100 rad/s for
 // 0.1 kg, 0.1 m links under 3,000 N, so dt omega = 4.6 at 1/240 s, and the
 // unstable mode's energy grows 200-fold per step. Such a mode shows first
-// as a gain of energy that no force supplied. So the step is split into
-// parts until the balance E1 - E0 - W holds to a tolerance, where W is the
-// efforts' work, and whatever gain is left is projected away by scaling
-// the velocities (Hairer, Lubich and Wanner 2006, "Geometric Numerical
-// Integration", section IV.4, projection onto the energy's level set).
-// Damping only takes energy out, so the balance is a bound: E1 <= E0 + W.
+// as a miss of the energy balance E1 = E0 + W, where W is the efforts'
+// work: the step's own error estimate, a scalar one. So the step is split
+// into parts until the balance holds to a tolerance, and the miss left is
+// projected away by scaling the velocities (Hairer, Lubich and Wanner 2006,
+// "Geometric Numerical Integration", section IV.4, projection onto the
+// energy's level set; with q fixed, u -> s u is the projection in the
+// kinetic energy's metric). Damping only takes energy out, so with it the
+// balance is a bound, E1 <= E0 + W, and only a gain is projected away.
 // With external wrenches on links the balance is not checked; the step then
 // keeps the split its last checked steps needed.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
-#include "physics/articulation/articulation_dynamics.h"
+#include "physics/articulation/free_motion.h"
 
 namespace rigid_body_sim::physics {
 namespace {
 
-// A step may gain this share of the kinetic energy before it is split; the
-// gain left below it is projected away.
-constexpr double kGainTolerance = 1e-8;
+// A step may miss the balance by this share of the kinetic energy before
+// it is split: a loose estimate of RK4's local error, tight enough to catch
+// an unstable mode while its energy is still this small a share.
+constexpr double kBalanceTolerance = 1e-5;
 // Rounding in E = sum of the links' terms, as a share of their magnitudes.
 constexpr double kRounding = 1e-12;
 // After this many steps at one split, the next step tries half as many parts.
@@ -38,10 +42,8 @@ struct Energy {
 };
 
 // E = sum_i (m_i v_i^2 / 2 + omega_i . I_i omega_i / 2 - m_i g . c_i).
-Energy ComputeEnergy(const ArticulationModel& model, const ArticulationState& state,
-                     const Vec3& gravity) {
-  ArticulationKinematics k;
-  ComputeKinematics(model, state, &k, KinematicsParts::kPosesAndVelocities);
+Energy EnergyOf(const ArticulationModel& model, const ArticulationKinematics& k,
+                const Vec3& gravity) {
   Energy energy;
   for (std::size_t i = 0; i < model.links.size(); ++i) {
     const double mass = model.links[i].mass;
@@ -63,52 +65,113 @@ bool WrenchesOnLinks(const ArticulationModel& model) {
   return false;
 }
 
-ArticulationState StepInParts(const FreeMotionStep& step, int parts) {
-  ArticulationState state = step.state;
-  const double h = step.dt / parts;
-  for (int part = 0; part < parts; ++part) {
-    state = StepFreeMotion(step.model, state, step.gravity, step.joint_efforts, h,
-                           part == 0 ? step.start_acceleration : nullptr);
-  }
-  return state;
+// The velocities of a state whose u is scaled by s: every one is linear in u.
+void ScaleVelocities(double s, ArticulationKinematics* k) {
+  for (Vec3& v : k->linear_velocity) v *= s;
+  for (Vec3& w : k->angular_velocity) w *= s;
+  for (double& v : k->joint_velocity) v *= s;
 }
 
 }  // namespace
 
-ArticulationState StepFreeMotionBalanced(const FreeMotionStep& step, FreeMotionSplit* split) {
-  split->parts = std::clamp(split->parts, 1, kMaxFreeMotionParts);
-  if (split->parts > 1 && split->steps_at_parts >= kStepsBeforeFewerParts) {
-    split->parts /= 2;
-    split->steps_at_parts = 0;
+void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd& end) {
+  parts_ = std::clamp(parts_, 1, kMaxParts);
+  if (parts_ > 1 && steps_at_parts_ >= kStepsBeforeFewerParts) {
+    parts_ /= 2;
+    steps_at_parts_ = 0;
   }
   if (WrenchesOnLinks(step.model)) {
-    ++split->steps_at_parts;
-    return StepInParts(step, split->parts);
+    ++steps_at_parts_;
+    StepInParts(step, parts_, end.state);
+    ComputeKinematics(step.model, *end.state, end.kinematics, KinematicsParts::kPosesAndVelocities);
+    return;
   }
-  const Energy before = ComputeEnergy(step.model, step.state, step.gravity);
-  const int parts_at_start = split->parts;
+  const bool exact_balance = !AnyJointDamped(step.model);
+  const Energy before = EnergyOf(step.model, step.kinematics, step.gravity);
+  const int parts_at_start = parts_;
   for (;;) {
-    ArticulationState next = StepInParts(step, split->parts);
-    const Energy after = ComputeEnergy(step.model, next, step.gravity);
+    StepInParts(step, parts_, end.state);
+    ComputeKinematics(step.model, *end.state, end.kinematics, KinematicsParts::kPosesAndVelocities);
+    const Energy after = EnergyOf(step.model, *end.kinematics, step.gravity);
     // The efforts are constant over the step: W = tau . (q1 - q0).
-    const double work = step.joint_efforts.dot(next.q - step.state.q);
+    const double work = step.joint_efforts.dot(end.state->q - step.state.q);
     const double allowed = before.kinetic + before.potential + work;
-    const double gain = after.kinetic + after.potential - allowed;
-    const double tolerance = kGainTolerance * std::max(before.kinetic, after.kinetic) +
-                             kRounding * (before.magnitude + after.magnitude);
-    // Written so that a state that is not finite (NaN gain) is split too.
-    if (!(gain <= tolerance) && split->parts < kMaxFreeMotionParts) {
-      split->parts *= 2;
+    const double miss = after.kinetic + after.potential - allowed;
+    const double rounding = kRounding * (before.magnitude + after.magnitude);
+    const double tolerance =
+        kBalanceTolerance * std::max(before.kinetic, after.kinetic) + rounding;
+    const double error = exact_balance ? std::abs(miss) : miss;
+    // Written so that a state that is not finite (NaN miss) is split too.
+    if (!(error <= tolerance) && parts_ < kMaxParts) {
+      parts_ *= 2;
       continue;
     }
-    split->steps_at_parts = split->parts == parts_at_start ? split->steps_at_parts + 1 : 0;
-    if (gain > 0.0 && std::isfinite(gain)) {
-      // The kinetic energy is u^T M(q) u / 2: scaling u by s scales it by s^2.
-      const double kinetic = allowed - after.potential;
-      next.u *= kinetic > 0.0 && after.kinetic > 0.0 ? std::sqrt(kinetic / after.kinetic) : 0.0;
-    }
-    return next;
+    steps_at_parts_ = parts_ == parts_at_start ? steps_at_parts_ + 1 : 0;
+    // A loss is given back only when it is within the tolerance: a larger
+    // one at the most parts is not the balance's rounding to restore.
+    const bool project = miss > 0.0 || (exact_balance && error <= tolerance);
+    if (!std::isfinite(miss) || !project) return;
+    // K = u^T M(q) u / 2: scaling u by s scales it by s^2. The target lies
+    // the rounding below the balance, so that E never ends above E0 + W.
+    const double kinetic = allowed - rounding - after.potential;
+    double s = kinetic > 0.0 && after.kinetic > 0.0 ? std::sqrt(kinetic / after.kinetic) : 0.0;
+    if (s == 0.0 && miss <= 0.0) s = 1.0;
+    end.state->u *= s;
+    ScaleVelocities(s, end.kinematics);
+    return;
   }
+}
+
+void FreeMotionIntegrator::StepInParts(const FreeMotionStep& step, int parts,
+                                       ArticulationState* next) {
+  const double h = step.dt / parts;
+  if (parts == 1) {
+    RungeKuttaStep(step, step.state, h, /*from_step_start=*/true, next);
+    return;
+  }
+  part_start_ = step.state;
+  for (int part = 0; part < parts; ++part) {
+    RungeKuttaStep(step, part_start_, h, part == 0, next);
+    if (part + 1 < parts) std::swap(part_start_, *next);
+  }
+}
+
+void FreeMotionIntegrator::Accelerate(const FreeMotionStep& step, const ArticulationState& state,
+                                      Eigen::VectorXd* acceleration) {
+  ComputeKinematics(step.model, state, &kinematics_, KinematicsParts::kPosesAndVelocities);
+  ForwardDynamics({step.model, state, kinematics_, step.gravity, step.joint_efforts}, &dynamics_,
+                  acceleration);
+}
+
+// Classical RK4 (Kutta 1901; Hairer, Norsett and Wanner 1993, "Solving
+// Ordinary Differential Equations I", section II.1): k1..k4 at t, t + h/2,
+// t + h/2, t + h, combined as (k1 + 2 k2 + 2 k3 + k4) / 6. The base
+// orientation takes the weighted mean angular velocity as one turn, which
+// keeps it a unit quaternion.
+void FreeMotionIntegrator::RungeKuttaStep(const FreeMotionStep& step,
+                                          const ArticulationState& start, double h,
+                                          bool from_step_start, ArticulationState* next) {
+  const ArticulationModel& model = step.model;
+  std::array<Eigen::VectorXd, 4>& a = stage_acceleration_;
+  const Eigen::VectorXd& u1 = start.u;
+  const bool given = from_step_start && step.start_acceleration != nullptr;
+  if (!given) Accelerate(step, start, &a[0]);
+  const Eigen::VectorXd& a1 = given ? *step.start_acceleration : a[0];
+  AdvanceInto(model, start, u1, 0.5 * h, &stage_);
+  stage_.u = u1 + 0.5 * h * a1;
+  Accelerate(step, stage_, &a[1]);
+  velocity_sum_ = u1 + 2.0 * stage_.u;
+  AdvanceInto(model, start, stage_.u, 0.5 * h, &stage_);
+  stage_.u = u1 + 0.5 * h * a[1];
+  Accelerate(step, stage_, &a[2]);
+  velocity_sum_ += 2.0 * stage_.u;
+  AdvanceInto(model, start, stage_.u, h, &stage_);
+  stage_.u = u1 + h * a[2];
+  Accelerate(step, stage_, &a[3]);
+  velocity_sum_ += stage_.u;
+  velocity_sum_ /= 6.0;
+  AdvanceInto(model, start, velocity_sum_, h, next);
+  next->u = u1 + h / 6.0 * (a1 + 2.0 * a[1] + 2.0 * a[2] + a[3]);
 }
 
 }  // namespace rigid_body_sim::physics

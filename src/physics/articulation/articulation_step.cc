@@ -14,6 +14,7 @@
 // bounce.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "physics/articulation/articulation_system.h"
 #include "physics/contact/contact_frame.h"
@@ -191,12 +192,11 @@ void ArticulationSystem::Solve(const StepContext& step) {
     }
   }
   std::vector<int> slot(articulations_.size(), -1);
-  std::vector<ArticulationKinematics> kinematics(articulations_.size());
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     if (!articulations_[i].in_use) continue;
-    slot[i] = SetUpArticulation(step, i, touched[i] != 0, &kinematics[i]);
+    slot[i] = SetUpArticulation(step, i, touched[i] != 0);
   }
-  AddLinkContactRows(step, slot, kinematics);
+  AddLinkContactRows(step, slot);
   solver_.Solve(kMaxSweeps, kSweepTolerance);
 
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
@@ -215,7 +215,7 @@ void ArticulationSystem::Solve(const StepContext& step) {
 // gets no solver slot, -1); otherwise it joins the row solve with M + dt B
 // and its joint rows, and its solver slot is returned.
 int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t index,
-                                          bool touched, ArticulationKinematics* kinematics) {
+                                          bool touched) {
   ArticulationEntry& entry = articulations_[index];
   ArticulationModel& model = entry.model;
   std::vector<JointRowSpec>& joint_rows = joint_row_scratch_;
@@ -225,10 +225,16 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
     link.torque = bodies_[link.body].torque;
   }
   const Eigen::VectorXd efforts = CommandedEfforts(model);
-  ArticulationKinematics& k = *kinematics;
-  ComputeKinematics(
-      model, entry.state, &k,
-      touched ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
+  // The last step's end (or a teleport's placement) computed them already,
+  // unless Jacobians are wanted now.
+  ArticulationKinematics& k = entry.kinematics;
+  if (!entry.kinematics_current || (touched && k.jacobian.empty())) {
+    ComputeKinematics(
+        model, entry.state, &k,
+        touched ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
+    entry.kinematics_current = true;
+  }
+  entry.next_kinematics_current = false;
   ForwardDynamics({model, entry.state, k, step.settings->gravity, efforts, step.dt}, &scratch_,
                   &acceleration);
   const Eigen::VectorXd u_free = entry.state.u + step.dt * acceleration;
@@ -240,9 +246,10 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
     // Without damping, u* came from the explicit dynamics: the first
     // RK4 stage's u'.
     const bool damped = AnyJointDamped(model);
-    entry.next = StepFreeMotionBalanced({model, entry.state, step.settings->gravity, efforts,
-                                         step.dt, damped ? nullptr : &acceleration},
-                                        &entry.free_motion_split);
+    entry.free_motion.Step({model, entry.state, k, step.settings->gravity, efforts, step.dt,
+                            damped ? nullptr : &acceleration},
+                           {&entry.next, &entry.next_kinematics});
+    entry.next_kinematics_current = true;
     return -1;
   }
   Eigen::MatrixXd mass;
@@ -321,13 +328,17 @@ void ArticulationSystem::Move() {
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     ArticulationEntry& entry = articulations_[i];
     if (!entry.in_use) continue;
-    if (StateIsSane(entry.next)) {
+    const bool sane = StateIsSane(entry.next);
+    if (sane) {
       entry.state = entry.next;
     } else {
       entry.state.u.setZero();
       entry.next = entry.state;
     }
-    PlaceLinks(i, entry.state, /*restart=*/false);
+    entry.kinematics_current = sane && entry.next_kinematics_current;
+    if (entry.kinematics_current) std::swap(entry.kinematics, entry.next_kinematics);
+    entry.next_kinematics_current = false;
+    PlaceLinks(i, /*restart=*/false);
   }
 }
 

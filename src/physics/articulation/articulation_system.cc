@@ -267,7 +267,8 @@ Status ArticulationSystem::SetJointStates(ArticulationId id, const std::vector<d
   }
   entry.state = state;
   entry.next = state;
-  PlaceLinks(id.index, state, /*restart=*/true);
+  entry.kinematics_current = false;
+  PlaceLinks(id.index, /*restart=*/true);
   return Status::Ok();
 }
 
@@ -331,17 +332,21 @@ Status ArticulationSystem::MoveWithLink(std::uint32_t index, const Pose& world_f
   }
   entry.state = state;
   entry.next = state;
-  PlaceLinks(index, state, /*restart=*/true);
+  entry.kinematics_current = false;
+  PlaceLinks(index, /*restart=*/true);
   return Status::Ok();
 }
 
 // Puts every link body where the state says, with its velocity. A restart
 // (a teleport) also forgets the links' contacts and wakes what touched them.
-void ArticulationSystem::PlaceLinks(std::uint32_t index, const ArticulationState& state,
-                                    bool restart) {
-  const ArticulationEntry& entry = articulations_[index];
-  ArticulationKinematics k;
-  ComputeKinematics(entry.model, state, &k, KinematicsParts::kPosesAndVelocities);
+void ArticulationSystem::PlaceLinks(std::uint32_t index, bool restart) {
+  ArticulationEntry& entry = articulations_[index];
+  if (!entry.kinematics_current) {
+    ComputeKinematics(entry.model, entry.state, &entry.kinematics,
+                      KinematicsParts::kPosesAndVelocities);
+    entry.kinematics_current = true;
+  }
+  const ArticulationKinematics& k = entry.kinematics;
   for (std::size_t i = 0; i < entry.model.links.size(); ++i) {
     const std::uint32_t body_index = entry.model.links[i].body;
     Body& body = bodies_[body_index];

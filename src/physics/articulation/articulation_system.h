@@ -13,6 +13,7 @@
 
 #include "physics/articulation/articulation_dynamics.h"
 #include "physics/articulation/articulation_solver.h"
+#include "physics/articulation/free_motion.h"
 #include "physics/contact/contact_cache.h"
 #include "physics/world/step_context.h"
 #include "rigid_body_sim/physics/articulation.h"
@@ -57,8 +58,14 @@ struct ArticulationEntry {
   ArticulationModel model;
   ArticulationState state;
   ArticulationState next;
+  // Of `state` while `kinematics_current` (whoever sets `state` clears it);
+  // of `next` while `next_kinematics_current` (the free step fills them).
+  ArticulationKinematics kinematics;
+  ArticulationKinematics next_kinematics;
+  bool kinematics_current = false;
+  bool next_kinematics_current = false;
   ServoGains gains;
-  FreeMotionSplit free_motion_split;
+  FreeMotionIntegrator free_motion;
   bool in_use = false;
   std::uint32_t generation = 0;
 };
@@ -106,24 +113,19 @@ class ArticulationSystem {
   static constexpr int kMaxSweeps = 200;
   static constexpr double kSweepTolerance = 1e-9;
 
-  void PlaceLinks(std::uint32_t index, const ArticulationState& state, bool restart);
-  int SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched,
-                        ArticulationKinematics* kinematics);
+  // Places the links where entry.state says (from its kinematics, computed
+  // if they are not current).
+  void PlaceLinks(std::uint32_t index, bool restart);
+  int SetUpArticulation(const StepContext& step, std::uint32_t index, bool touched);
   void AddArticulationRows(std::uint32_t index, int slot, const std::vector<JointRowSpec>& rows);
-  // What a link-contact row's sides read: each articulation's solver slot
-  // and kinematics this step.
-  struct LinkRowContext {
-    const std::vector<int>* slot_of_articulation;
-    const std::vector<ArticulationKinematics>* kinematics;
-  };
-  void AddLinkContactRows(const StepContext& step, const std::vector<int>& slot_of_articulation,
-                          const std::vector<ArticulationKinematics>& kinematics);
-  int AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+  // A link-contact row's sides read each articulation's solver slot and
+  // its entry's kinematics (with Jacobians, for those with contacts).
+  void AddLinkContactRows(const StepContext& step, const std::vector<int>& slot_of_articulation);
+  int AddLinkPointRows(const StepContext& step, const std::vector<int>& slot_of_articulation,
                        const ShapePairContact& pair, int i);
-  RowSide LinkContactSide(const LinkRowContext& context, std::uint32_t index, const Vec3& direction,
-                          const Vec3& point);
-  double StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
-                            std::uint32_t index, const Vec3& direction, const Vec3& point) const;
+  RowSide LinkContactSide(const std::vector<int>& slot_of_articulation, std::uint32_t index,
+                          const Vec3& direction, const Vec3& point);
+  double StartPointVelocity(std::uint32_t index, const Vec3& direction, const Vec3& point) const;
   void BounceLinkContacts(const StepContext& step, const std::vector<int>& slot_of_articulation);
   std::vector<double> LinkImpactTimes(const StepContext& step,
                                       const std::vector<int>& slot_of_articulation);

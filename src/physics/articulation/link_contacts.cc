@@ -13,13 +13,13 @@ namespace rigid_body_sim::physics {
 // d . (velocity of the body's point at `point`) before this step's forces:
 // a link's from the joint-space velocity the step starts with, a rigid
 // body's from the momenta IntegrateForces started from.
-double ArticulationSystem::StartPointVelocity(const std::vector<ArticulationKinematics>& kinematics,
-                                              std::uint32_t index, const Vec3& direction,
+double ArticulationSystem::StartPointVelocity(std::uint32_t index, const Vec3& direction,
                                               const Vec3& point) const {
   const Body& body = bodies_[index];
   const Vec3 r = point - body.position;
   if (body.articulation >= 0) {
-    const JacobianRows& jacobian = kinematics[body.articulation].jacobian[body.link];
+    const ArticulationEntry& entry = articulations_[body.articulation];
+    const JacobianRows& jacobian = entry.kinematics.jacobian[body.link];
     const Eigen::VectorXd& u = articulations_[body.articulation].state.u;
     const Vec3 linear = jacobian.topRows<3>() * u;
     const Vec3 angular = jacobian.bottomRows<3>() * u;
@@ -33,12 +33,13 @@ double ArticulationSystem::StartPointVelocity(const std::vector<ArticulationKine
 // One side of a link-contact row along `direction` at `point`: a link's
 // through its Jacobian (J_v^T d + J_w^T (r x d)), a rigid body's through
 // its mass and inertia (a static or resting one has none).
-RowSide ArticulationSystem::LinkContactSide(const LinkRowContext& context, std::uint32_t index,
-                                            const Vec3& direction, const Vec3& point) {
+RowSide ArticulationSystem::LinkContactSide(const std::vector<int>& slot_of_articulation,
+                                            std::uint32_t index, const Vec3& direction,
+                                            const Vec3& point) {
   const Body& body = bodies_[index];
   if (body.articulation >= 0) {
-    const int articulation_slot = (*context.slot_of_articulation)[body.articulation];
-    const JacobianRows& jacobian = (*context.kinematics)[body.articulation].jacobian[body.link];
+    const int articulation_slot = slot_of_articulation[body.articulation];
+    const JacobianRows& jacobian = articulations_[body.articulation].kinematics.jacobian[body.link];
     const Vec3 r = point - body.position;
     const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
                                 jacobian.bottomRows<3>().transpose() * r.cross(direction);
@@ -68,15 +69,13 @@ RowSide ArticulationSystem::LinkContactSide(const LinkRowContext& context, std::
 // ground closes at g dt by the end of the free step, above the collision
 // threshold, and with e > 0 it would hop every step.
 void ArticulationSystem::AddLinkContactRows(const StepContext& step,
-                                            const std::vector<int>& slot_of_articulation,
-                                            const std::vector<ArticulationKinematics>& kinematics) {
-  const LinkRowContext context{&slot_of_articulation, &kinematics};
+                                            const std::vector<int>& slot_of_articulation) {
   link_pair_rows_.assign(link_pairs_.size(), -1);
   link_penetrations_.clear();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
     const ShapePairContact& pair = *link_pairs_[m];
     for (int i = 0; i < pair.manifold.point_count; ++i) {
-      const int normal_index = AddLinkPointRows(step, context, pair, i);
+      const int normal_index = AddLinkPointRows(step, slot_of_articulation, pair, i);
       if (i == 0) link_pair_rows_[m] = normal_index;
     }
   }
@@ -84,7 +83,8 @@ void ArticulationSystem::AddLinkContactRows(const StepContext& step,
 
 // Point `i` of a link pair: its normal row (classified as above) and two
 // friction rows; returns the normal row's index.
-int ArticulationSystem::AddLinkPointRows(const StepContext& step, const LinkRowContext& context,
+int ArticulationSystem::AddLinkPointRows(const StepContext& step,
+                                         const std::vector<int>& slot_of_articulation,
                                          const ShapePairContact& pair, int i) {
   const SolverSettings& solver = step.settings->solver;
   const Body& a = bodies_[pair.body_a];
@@ -99,11 +99,11 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step, const LinkRowC
   ConstraintRow normal_row;
   normal_row.kind = RowKind::kNormal;
   normal_row.restitution = restitution;
-  normal_row.a = LinkContactSide(context, pair.body_a, normal, point.position_world);
-  normal_row.b = LinkContactSide(context, pair.body_b, -normal, point.position_world);
+  normal_row.a = LinkContactSide(slot_of_articulation, pair.body_a, normal, point.position_world);
+  normal_row.b = LinkContactSide(slot_of_articulation, pair.body_b, -normal, point.position_world);
   const double approach =
-      StartPointVelocity(*context.kinematics, pair.body_a, normal, point.position_world) +
-      StartPointVelocity(*context.kinematics, pair.body_b, -normal, point.position_world);
+      StartPointVelocity(pair.body_a, normal, point.position_world) +
+      StartPointVelocity(pair.body_b, -normal, point.position_world);
   const double separation = point.separation;
   if (separation <= solver.contact_tolerance && approach < -solver.collision_velocity_threshold) {
     normal_row.target = -restitution * approach;
@@ -125,8 +125,8 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step, const LinkRowC
   for (int t = 0; t < 2; ++t) {
     ConstraintRow tangent_row;
     tangent_row.kind = RowKind::kTangent;
-    tangent_row.a = LinkContactSide(context, pair.body_a, tangent[t], point.position_world);
-    tangent_row.b = LinkContactSide(context, pair.body_b, -tangent[t], point.position_world);
+    tangent_row.a = LinkContactSide(slot_of_articulation, pair.body_a, tangent[t], point.position_world);
+    tangent_row.b = LinkContactSide(slot_of_articulation, pair.body_b, -tangent[t], point.position_world);
     tangent_row.normal_row = normal_index;
     tangent_row.friction = friction;
     tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
