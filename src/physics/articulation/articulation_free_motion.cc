@@ -29,11 +29,18 @@ namespace {
 // A step may miss the balance by this share of the kinetic energy before
 // it is split: a loose estimate of RK4's local error, tight enough to catch
 // an unstable mode while its energy is still this small a share.
-constexpr double kBalanceTolerance = 1e-5;
+constexpr double kBalanceTolerance = 1e-4;
 // Rounding in E = sum of the links' terms, as a share of their magnitudes.
 constexpr double kRounding = 1e-12;
-// After this many steps at one split, the next step tries half as many parts.
-constexpr int kStepsBeforeFewerParts = 64;
+// RK4's local error is O(h^5): a step in half as many parts misses the
+// balance by about 2^5 / 2 = 16 times as much.
+constexpr double kHalvingGrowth = 16.0;
+// Half as many parts are tried when the last step's miss, so grown, would
+// stay below this share of the tolerance.
+constexpr double kSafety = 0.5;
+// An unstable mode's miss does not follow the error's order: after fewer
+// parts failed, this many steps pass before they are tried again.
+constexpr int kStepsBeforeRetry = 64;
 
 struct Energy {
   double kinetic = 0.0;    // J
@@ -76,19 +83,16 @@ void ScaleVelocities(double s, ArticulationKinematics* k) {
 
 void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd& end) {
   parts_ = std::clamp(parts_, 1, kMaxParts);
-  if (parts_ > 1 && steps_at_parts_ >= kStepsBeforeFewerParts) {
-    parts_ /= 2;
-    steps_at_parts_ = 0;
-  }
   if (WrenchesOnLinks(step.model)) {
-    ++steps_at_parts_;
     StepInParts(step, parts_, end.state);
     ComputeKinematics(step.model, *end.state, end.kinematics, KinematicsParts::kPosesAndVelocities);
     return;
   }
+  bool fewer = parts_ > 1 && steps_before_retry_ == 0 && kHalvingGrowth * last_ratio_ < kSafety;
+  steps_before_retry_ = std::max(0, steps_before_retry_ - 1);
+  if (fewer) parts_ /= 2;
   const bool exact_balance = !AnyJointDamped(step.model);
   const Energy before = EnergyOf(step.model, step.kinematics, step.gravity);
-  const int parts_at_start = parts_;
   for (;;) {
     StepInParts(step, parts_, end.state);
     ComputeKinematics(step.model, *end.state, end.kinematics, KinematicsParts::kPosesAndVelocities);
@@ -104,9 +108,11 @@ void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd&
     // Written so that a state that is not finite (NaN miss) is split too.
     if (!(error <= tolerance) && parts_ < kMaxParts) {
       parts_ *= 2;
+      if (fewer) steps_before_retry_ = kStepsBeforeRetry;
+      fewer = false;
       continue;
     }
-    steps_at_parts_ = parts_ == parts_at_start ? steps_at_parts_ + 1 : 0;
+    last_ratio_ = error <= tolerance ? error / tolerance : 1.0;
     // A loss is given back only when it is within the tolerance: a larger
     // one at the most parts is not the balance's rounding to restore.
     const bool project = miss > 0.0 || (exact_balance && error <= tolerance);

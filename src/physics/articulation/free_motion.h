@@ -36,8 +36,9 @@ struct FreeMotionEnd {
 // The free motion of one articulation, step after step. A step is one RK4
 // step, or 2, 4, ... up to kMaxParts equal ones where the whole step would
 // miss the energy balance E1 = E0 + W (the efforts' work W) by more than
-// kBalanceTolerance of the kinetic energy; what is left of the miss is then
-// projected away by scaling u. Without joint damping or wrenches on the
+// 1e-5 of the kinetic energy; what is left of the miss is then
+// projected away by scaling u. A step starts from the last one's split, or
+// half of it when the last miss, grown as RK4's error grows, would pass. Without joint damping or wrenches on the
 // links the energy is kept to rounding; with damping the balance is a bound
 // (E1 <= E0 + W), and only a gain is projected away. With wrenches on links
 // the balance is not checked. Its buffers keep their size from step to
@@ -61,7 +62,11 @@ class FreeMotionIntegrator {
                   Eigen::VectorXd* acceleration);
 
   int parts_ = 1;
-  int steps_at_parts_ = 0;  // steps taken since `parts_` last changed
+  // The last checked step's miss over its tolerance (negative for a loss
+  // where the balance is a bound), and the steps to wait before fewer parts
+  // are tried again.
+  double last_ratio_ = 1.0;
+  int steps_before_retry_ = 0;
   ArticulationKinematics kinematics_;  // a stage's
   ArticulatedBodyScratch dynamics_;
   ArticulationState part_start_;
