@@ -32,15 +32,15 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 // The spatial inertia about O of a body of mass m, centre c (relative to
 // O) and inertia I_c about its centre: [I_c - m [c]x[c]x, m [c]x;
-// -m [c]x, m 1] (Featherstone 2008, equation 2.63).
-Mat6 SpatialInertia(double mass, const Vec3& c, const Mat3& inertia_com) {
-  const Mat3 cx = Skew(c);
-  Mat6 inertia;
-  inertia.topLeftCorner<3, 3>() = inertia_com - mass * cx * cx;
-  inertia.topRightCorner<3, 3>() = mass * cx;
-  inertia.bottomLeftCorner<3, 3>() = -mass * cx;
-  inertia.bottomRightCorner<3, 3>() = mass * Mat3::Identity();
-  return inertia;
+// -m [c]x, m 1] (Featherstone 2008, equation 2.63), with
+// -[c]x[c]x = |c|^2 1 - c c^T.
+void SpatialInertia(double mass, const Vec3& c, const Mat3& inertia_com, Mat6* inertia) {
+  const Mat3 cx = mass * Skew(c);
+  inertia->topLeftCorner<3, 3>() = inertia_com + mass * (c.squaredNorm() * Mat3::Identity() -
+                                                         c * c.transpose());
+  inertia->topRightCorner<3, 3>() = cx;
+  inertia->bottomLeftCorner<3, 3>() = -cx;
+  inertia->bottomRightCorner<3, 3>() = mass * Mat3::Identity();
 }
 
 // m1 x m2 = (w1 x w2, w1 x v2 + v1 x w2).
@@ -90,15 +90,21 @@ void ArticulatedBodyScratch::Prepare(const ForwardDynamicsInput& in) {
   for (std::size_t i = 0; i < link_count; ++i) {
     const ArticulationLink& link = model.links[i];
     const Vec3 c = k.com_world[i] - origin;
-    inertia[i] = SpatialInertia(link.mass, c, k.inertia_world[i]);
-    velocity[i].head<3>() = k.angular_velocity[i];
-    velocity[i].tail<3>() = k.linear_velocity[i] - k.angular_velocity[i].cross(c);
+    SpatialInertia(link.mass, c, k.inertia_world[i], &inertia[i]);
+    const Vec3& omega = k.angular_velocity[i];
+    const Vec3& v_com = k.linear_velocity[i];
+    velocity[i].head<3>() = omega;
+    velocity[i].tail<3>() = v_com - omega.cross(c);
     product[i].setZero();
+    // The momentum I v about O, from the centre's: (I_c omega + c x m v_c, m v_c).
+    Vec6 momentum;
+    momentum.tail<3>() = link.mass * v_com;
+    momentum.head<3>() = k.inertia_world[i] * omega + c.cross(momentum.tail<3>());
     const Vec3 force = link.mass * in.gravity + link.force;
     Vec6 external;
     external.head<3>() = link.torque + c.cross(force);
     external.tail<3>() = force;
-    bias[i] = CrossForce(velocity[i], inertia[i] * velocity[i]) - external;
+    bias[i] = CrossForce(velocity[i], momentum) - external;
   }
   for (std::size_t j = 0; j < model.joints.size(); ++j) {
     const JointDef& def = model.joints[j].def;
@@ -124,14 +130,18 @@ void ArticulatedBodyForwardDynamics(const ForwardDynamicsInput& in, ArticulatedB
     const int parent = joint.def.parent_link;
     const int column = model.base_dofs + joint.dof;
     const double tau = in.joint_efforts[joint.dof] - joint.def.damping * in.state.u[column];
-    s.inertia_subspace[j] = s.inertia[child] * s.subspace[j];
-    s.pivot[j] = s.subspace[j].dot(s.inertia_subspace[j]) + in.damping_step * joint.def.damping;
-    s.remainder[j] = tau - s.subspace[j].dot(s.bias[child]);
-    const Mat6 articulated =
-        s.inertia[child] - s.inertia_subspace[j] * s.inertia_subspace[j].transpose() / s.pivot[j];
+    const Vec6& subspace = s.subspace[j];
+    Vec6& inertia_subspace = s.inertia_subspace[j];
+    inertia_subspace.noalias() = s.inertia[child] * subspace;
+    s.pivot[j] = subspace.dot(inertia_subspace) + in.damping_step * joint.def.damping;
+    s.remainder[j] = tau - subspace.dot(s.bias[child]);
+    // A fixed base's articulated inertia and bias are never read.
+    if (parent == 0 && model.base_dofs == 0) continue;
+    const Vec6 scaled = inertia_subspace / s.pivot[j];
+    Mat6& articulated = s.inertia[child];
+    articulated.noalias() -= scaled * inertia_subspace.transpose();
     s.inertia[parent] += articulated;
-    s.bias[parent] += s.bias[child] + articulated * s.product[child] +
-                      s.inertia_subspace[j] * (s.remainder[j] / s.pivot[j]);
+    s.bias[parent] += s.bias[child] + articulated * s.product[child] + scaled * s.remainder[j];
   }
   acceleration->resize(model.DofCount());
   if (model.base_dofs == 6) {

@@ -79,6 +79,18 @@ void ScaleVelocities(double s, ArticulationKinematics* k) {
   for (double& v : k->joint_velocity) v *= s;
 }
 
+// How many times the parts of a step that missed by `ratio` times the
+// tolerance are to grow: the power of two that, by RK4's order (the miss
+// falls as parts^-4), brings the miss under kSafety of the tolerance; twice
+// for a miss that is not finite.
+int PartsGrowth(double ratio) {
+  if (!std::isfinite(ratio)) return 2;
+  const double needed = std::pow(ratio / kSafety, 0.25);
+  int growth = 2;
+  while (growth < needed && growth < FreeMotionIntegrator::kMaxParts) growth *= 2;
+  return growth;
+}
+
 }  // namespace
 
 void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd& end) {
@@ -107,7 +119,7 @@ void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd&
     const double error = exact_balance ? std::abs(miss) : miss;
     // Written so that a state that is not finite (NaN miss) is split too.
     if (!(error <= tolerance) && parts_ < kMaxParts) {
-      parts_ *= 2;
+      parts_ = std::min(kMaxParts, parts_ * PartsGrowth(error / tolerance));
       if (fewer) steps_before_retry_ = kStepsBeforeRetry;
       fewer = false;
       continue;
