@@ -36,8 +36,8 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 // -[c]x[c]x = |c|^2 1 - c c^T.
 void SpatialInertia(double mass, const Vec3& c, const Mat3& inertia_com, Mat6* inertia) {
   const Mat3 cx = mass * Skew(c);
-  inertia->topLeftCorner<3, 3>() = inertia_com + mass * (c.squaredNorm() * Mat3::Identity() -
-                                                         c * c.transpose());
+  inertia->topLeftCorner<3, 3>() =
+      inertia_com + mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
   inertia->topRightCorner<3, 3>() = cx;
   inertia->bottomLeftCorner<3, 3>() = -cx;
   inertia->bottomRightCorner<3, 3>() = mass * Mat3::Identity();

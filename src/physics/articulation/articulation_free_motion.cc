@@ -79,18 +79,6 @@ void ScaleVelocities(double s, ArticulationKinematics* k) {
   for (double& v : k->joint_velocity) v *= s;
 }
 
-// How many times the parts of a step that missed by `ratio` times the
-// tolerance are to grow: the power of two that, by RK4's order (the miss
-// falls as parts^-4), brings the miss under kSafety of the tolerance; twice
-// for a miss that is not finite.
-int PartsGrowth(double ratio) {
-  if (!std::isfinite(ratio)) return 2;
-  const double needed = std::pow(ratio / kSafety, 0.25);
-  int growth = 2;
-  while (growth < needed && growth < FreeMotionIntegrator::kMaxParts) growth *= 2;
-  return growth;
-}
-
 }  // namespace
 
 void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd& end) {
@@ -114,21 +102,20 @@ void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd&
     const double allowed = before.kinetic + before.potential + work;
     const double miss = after.kinetic + after.potential - allowed;
     const double rounding = kRounding * (before.magnitude + after.magnitude);
-    const double tolerance =
-        kBalanceTolerance * std::max(before.kinetic, after.kinetic) + rounding;
+    const double tolerance = kBalanceTolerance * std::max(before.kinetic, after.kinetic) + rounding;
     const double error = exact_balance ? std::abs(miss) : miss;
     // Written so that a state that is not finite (NaN miss) is split too.
     if (!(error <= tolerance) && parts_ < kMaxParts) {
-      parts_ = std::min(kMaxParts, parts_ * PartsGrowth(error / tolerance));
+      parts_ *= 2;
       if (fewer) steps_before_retry_ = kStepsBeforeRetry;
       fewer = false;
       continue;
     }
     last_ratio_ = error <= tolerance ? error / tolerance : 1.0;
-    // A loss is given back only when it is within the tolerance: a larger
-    // one at the most parts is not the balance's rounding to restore.
-    const bool project = miss > 0.0 || (exact_balance && error <= tolerance);
-    if (!std::isfinite(miss) || !project) return;
+    // Where the balance is exact, the state is put back on its level set
+    // whichever way it missed, even by more than the tolerance at the most
+    // parts; where it is a bound, only a gain is taken away.
+    if (!std::isfinite(miss) || !(miss > 0.0 || exact_balance)) return;
     // K = u^T M(q) u / 2: scaling u by s scales it by s^2. The target lies
     // the rounding below the balance, so that E never ends above E0 + W.
     const double kinetic = allowed - rounding - after.potential;

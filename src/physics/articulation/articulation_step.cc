@@ -45,15 +45,15 @@ Eigen::VectorXd Unit(int size, int index, double sign) {
 // The generalized efforts commanded directly, per dof: each joint's
 // command clamped to its limit, which its mimics exert too (scaled by their
 // multipliers), so a dof with mimics gets effort_scale times it.
-Eigen::VectorXd CommandedEfforts(const ArticulationModel& model) {
-  Eigen::VectorXd efforts = Eigen::VectorXd::Zero(model.joint_dofs);
+void CommandedEfforts(const ArticulationModel& model, Eigen::VectorXd* out) {
+  Eigen::VectorXd& efforts = *out;
+  efforts.setZero(model.joint_dofs);
   for (const ArticulationJoint& joint : model.joints) {
     if (joint.dof < 0 || joint.command.mode != JointCommandMode::kEffort) continue;
     efforts[joint.dof] =
         joint.effort_scale *
         std::clamp(joint.command.effort, -joint.def.effort_limit, joint.def.effort_limit);
   }
-  return efforts;
 }
 
 // Whether the free step's explicit RK4 would be unstable or inexact under
@@ -185,13 +185,15 @@ void ArticulationSystem::AddArticulationRows(std::uint32_t index, int slot,
 void ArticulationSystem::Solve(const StepContext& step) {
   if (articulations_.empty()) return;
   solver_.Reset();
-  std::vector<char> touched(articulations_.size(), 0);
+  std::vector<char>& touched = touched_scratch_;
+  touched.assign(articulations_.size(), 0);
   for (const ShapePairContact* pair : link_pairs_) {
     for (const std::uint32_t body : {pair->body_a, pair->body_b}) {
       if (bodies_[body].articulation >= 0) touched[bodies_[body].articulation] = 1;
     }
   }
-  std::vector<int> slot(articulations_.size(), -1);
+  std::vector<int>& slot = slot_scratch_;
+  slot.assign(articulations_.size(), -1);
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     if (!articulations_[i].in_use) continue;
     slot[i] = SetUpArticulation(step, i, touched[i] != 0);
@@ -224,7 +226,8 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
     link.force = bodies_[link.body].force;
     link.torque = bodies_[link.body].torque;
   }
-  const Eigen::VectorXd efforts = CommandedEfforts(model);
+  Eigen::VectorXd& efforts = efforts_scratch_;
+  CommandedEfforts(model, &efforts);
   // The last step's end (or a teleport's placement) computed them already,
   // unless Jacobians are wanted now.
   ArticulationKinematics& k = entry.kinematics;
@@ -237,7 +240,8 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
   entry.next_kinematics_current = false;
   ForwardDynamics({model, entry.state, k, step.settings->gravity, efforts, step.dt}, &scratch_,
                   &acceleration);
-  const Eigen::VectorXd u_free = entry.state.u + step.dt * acceleration;
+  Eigen::VectorXd& u_free = free_velocity_scratch_;
+  u_free = entry.state.u + step.dt * acceleration;
   JointRowsOf(entry, u_free, step.dt, entry.gains, &joint_rows);
   for (ArticulationJoint& joint : model.joints) {
     joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;

@@ -140,6 +140,10 @@ class ArticulationSystem {
   ArticulationSolver solver_;
   ArticulatedBodyScratch scratch_;               // SetUpArticulation's
   std::vector<JointRowSpec> joint_row_scratch_;  // SetUpArticulation's
+  Eigen::VectorXd efforts_scratch_;              // SetUpArticulation's
+  Eigen::VectorXd free_velocity_scratch_;        // SetUpArticulation's, u*
+  std::vector<char> touched_scratch_;            // Solve's, per articulation
+  std::vector<int> slot_scratch_;                // Solve's, per articulation
   Eigen::VectorXd acceleration_scratch_;
   std::vector<ShapePairContact*> link_pairs_;  // TakeLinkPairs'
   // Per link pair, the index of its first normal row, or -1.

@@ -101,9 +101,8 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
   normal_row.restitution = restitution;
   normal_row.a = LinkContactSide(slot_of_articulation, pair.body_a, normal, point.position_world);
   normal_row.b = LinkContactSide(slot_of_articulation, pair.body_b, -normal, point.position_world);
-  const double approach =
-      StartPointVelocity(pair.body_a, normal, point.position_world) +
-      StartPointVelocity(pair.body_b, -normal, point.position_world);
+  const double approach = StartPointVelocity(pair.body_a, normal, point.position_world) +
+                          StartPointVelocity(pair.body_b, -normal, point.position_world);
   const double separation = point.separation;
   if (separation <= solver.contact_tolerance && approach < -solver.collision_velocity_threshold) {
     normal_row.target = -restitution * approach;
@@ -125,8 +124,10 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
   for (int t = 0; t < 2; ++t) {
     ConstraintRow tangent_row;
     tangent_row.kind = RowKind::kTangent;
-    tangent_row.a = LinkContactSide(slot_of_articulation, pair.body_a, tangent[t], point.position_world);
-    tangent_row.b = LinkContactSide(slot_of_articulation, pair.body_b, -tangent[t], point.position_world);
+    tangent_row.a =
+        LinkContactSide(slot_of_articulation, pair.body_a, tangent[t], point.position_world);
+    tangent_row.b =
+        LinkContactSide(slot_of_articulation, pair.body_b, -tangent[t], point.position_world);
     tangent_row.normal_row = normal_index;
     tangent_row.friction = friction;
     tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];

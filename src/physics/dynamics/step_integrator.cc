@@ -429,7 +429,9 @@ bool WorldImpl::UpdateSpeedingUp(const StepContext& step, Body* body) const {
 void WorldImpl::UpdateSleep(const StepContext& step) {
   const SleepSettings& sleep = settings_.sleep;
   if (!sleep.enabled) return;
-  UnionFind islands(bodies_.size());
+  // The islands' scratch keeps its memory from step to step.
+  UnionFind& islands = sleep_scratch_.islands;
+  islands.Reset(bodies_.size());
   for (const ShapePairContact* pair : contact_cache_.touching()) {
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
@@ -437,13 +439,15 @@ void WorldImpl::UpdateSleep(const StepContext& step) {
     islands.Join(pair->body_a, pair->body_b);
   }
   // Articulations never sleep, nor does what touches them.
-  std::vector<char> island_has_link(bodies_.size(), 0);
+  std::vector<char>& island_has_link = sleep_scratch_.island_has_link;
+  island_has_link.assign(bodies_.size(), 0);
   for (const ShapePairContact* pair : articulations_.link_pairs()) {
     for (const std::uint32_t index : {pair->body_a, pair->body_b}) {
       if (bodies_[index].articulation >= 0) island_has_link[islands.Find(index)] = 1;
     }
   }
-  std::vector<double> island_sleep_time(bodies_.size(), std::numeric_limits<double>::infinity());
+  std::vector<double>& island_sleep_time = sleep_scratch_.island_sleep_time;
+  island_sleep_time.assign(bodies_.size(), std::numeric_limits<double>::infinity());
   sleep_windows_.resize(bodies_.size());
   const SleepWindowLimits limits =
       MakeSleepWindowLimits(sleep.linear_velocity, sleep.angular_velocity, sleep.time_to_sleep);

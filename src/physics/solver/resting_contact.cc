@@ -244,6 +244,7 @@ template <bool kPseudo>
 // group, so the count of the slowest is the same as with one.
 void ContactSolver::SweepUntilConverged() {
   const std::size_t group_count = schedules_.size();
+  if (group_count == 0 || rows_.empty()) return;
   std::vector<int> sweeps(group_count, 0);
   std::vector<std::size_t> row_updates(group_count, 0);
   RunGroups(pool_, group_count, [&](std::size_t group) {

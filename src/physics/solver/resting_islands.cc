@@ -67,6 +67,11 @@ void ContactSolver::ScheduleRuns() {
     std::array<std::uint32_t, 2> moving;  // kFixedBody for a body that does not move
     bool scheduled;
   };
+  if (rows_.empty()) {
+    // Nothing to schedule, and nothing allocated for it.
+    for (std::vector<SweepTask>& schedule : schedules_) schedule.clear();
+    return;
+  }
   auto moving = [&](std::uint32_t index) { return Moves(bodies_[index]) ? index : kFixedBody; };
   std::vector<Run> runs;
   for (std::uint32_t r = 0; r < rows_.size();) {

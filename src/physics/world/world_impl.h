@@ -20,6 +20,7 @@
 #include "physics/solver/motion_solver.h"
 #include "physics/world/step_context.h"
 #include "physics/world/task_pool.h"
+#include "physics/world/union_find.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
@@ -205,6 +206,12 @@ class WorldImpl : public LinkBodies {
   std::vector<std::uint8_t> push_state_;      // 0 not pushed, 1 along one normal, 2 several
   std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
   std::vector<SleepWindow> sleep_windows_;    // the sleep test's, per body slot (UpdateSleep)
+  // UpdateSleep's per-step buffers, kept so that a step does not allocate.
+  struct SleepScratch {
+    UnionFind islands;
+    std::vector<char> island_has_link;
+    std::vector<double> island_sleep_time;
+  } sleep_scratch_;
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
   std::vector<BodyId> non_finite_bodies_;
