@@ -48,11 +48,13 @@ struct Energy {
   double magnitude = 0.0;  // J, the sum of the terms' magnitudes
 };
 
-// E = sum_i (m_i v_i^2 / 2 + omega_i . I_i omega_i / 2 - m_i g . c_i).
+// E = sum_i (m_i v_i^2 / 2 + omega_i . I_i omega_i / 2 - m_i g . c_i) over
+// the links that move: a fixed base's constant term would only change the
+// rounding (a base of mass 0 and one of 1 kg must swing the same arm alike).
 Energy EnergyOf(const ArticulationModel& model, const ArticulationKinematics& k,
                 const Vec3& gravity) {
   Energy energy;
-  for (std::size_t i = 0; i < model.links.size(); ++i) {
+  for (std::size_t i = model.fixed_base ? 1 : 0; i < model.links.size(); ++i) {
     const double mass = model.links[i].mass;
     const double kinetic =
         0.5 * (mass * k.linear_velocity[i].squaredNorm() +
@@ -112,13 +114,15 @@ void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd&
       continue;
     }
     last_ratio_ = error <= tolerance ? error / tolerance : 1.0;
-    // Where the balance is exact, the state is put back on its level set
-    // whichever way it missed, even by more than the tolerance at the most
-    // parts; where it is a bound, only a gain is taken away.
-    if (!std::isfinite(miss) || !(miss > 0.0 || exact_balance)) return;
-    // K = u^T M(q) u / 2: scaling u by s scales it by s^2. The target lies
-    // the rounding below the balance, so that E never ends above E0 + W.
-    const double kinetic = allowed - rounding - after.potential;
+    // A gain is always taken away. Where the balance is exact, a loss beyond
+    // the rounding is given back, even one beyond the tolerance at the most
+    // parts; where it is a bound, a loss is the damping's. A loss within the
+    // rounding is left: projecting it would only move the state by rounding
+    // (a free fall, which RK4 integrates exactly, would drift).
+    const bool project = miss > 0.0 || (exact_balance && miss < -rounding);
+    if (!std::isfinite(miss) || !project) return;
+    // K = u^T M(q) u / 2: scaling u by s scales it by s^2.
+    const double kinetic = allowed - after.potential;
     double s = kinetic > 0.0 && after.kinetic > 0.0 ? std::sqrt(kinetic / after.kinetic) : 0.0;
     if (s == 0.0 && miss <= 0.0) s = 1.0;
     end.state->u *= s;
