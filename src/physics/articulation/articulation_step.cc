@@ -44,15 +44,23 @@ Eigen::VectorXd Unit(int size, int index, double sign) {
 
 // The generalized efforts commanded directly, per dof: each joint's
 // command clamped to its limit, which its mimics exert too (scaled by their
-// multipliers), so a dof with mimics gets effort_scale times it.
-void CommandedEfforts(const ArticulationModel& model, Eigen::VectorXd* out) {
+// multipliers), so a dof with mimics gets effort_scale times it. As
+// Gazebo's Joint::CheckAndTruncateForce does, an effort that would drive a
+// joint at or past its speed limit further is not applied: the URDF's
+// velocity limit bounds what the joint's actuator drives, not its passive
+// motion.
+void CommandedEfforts(const ArticulationModel& model, const ArticulationState& state,
+                      Eigen::VectorXd* out) {
   Eigen::VectorXd& efforts = *out;
   efforts.setZero(model.joint_dofs);
   for (const ArticulationJoint& joint : model.joints) {
     if (joint.dof < 0 || joint.command.mode != JointCommandMode::kEffort) continue;
-    efforts[joint.dof] =
-        joint.effort_scale *
+    const double effort =
         std::clamp(joint.command.effort, -joint.def.effort_limit, joint.def.effort_limit);
+    const double u = state.u[model.base_dofs + joint.dof];
+    const double limit = joint.def.velocity_limit;
+    if ((effort > 0.0 && u > limit) || (effort < 0.0 && u < -limit)) continue;
+    efforts[joint.dof] = joint.effort_scale * effort;
   }
 }
 
@@ -108,7 +116,12 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
     };
     if (q + dt * u < def.lower + reach) add(1.0, RowKind::kNormal, (def.lower - q) / dt, 0.0, 0.0);
     if (q + dt * u > def.upper - reach) add(-1.0, RowKind::kNormal, (q - def.upper) / dt, 0.0, 0.0);
-    if (std::abs(u) > def.velocity_limit) {
+    // A motor or servo drives no faster than the joint's speed limit; a limp
+    // joint, or one given an effort, is not held to it (as in Gazebo,
+    // Bullet and MuJoCo: a limp arm falls freely).
+    const bool driven = joint.command.mode == JointCommandMode::kVelocity ||
+                        joint.command.mode == JointCommandMode::kPosition;
+    if (driven && std::abs(u) > def.velocity_limit) {
       add(u > 0.0 ? -1.0 : 1.0, RowKind::kNormal, -def.velocity_limit, 0.0, 0.0);
     }
     if (def.friction > 0.0) add(1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
@@ -119,7 +132,9 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
       const double bound = motor_cap > 0.0
                                ? std::min(effort_bound, joint.effort_scale * motor_cap * dt)
                                : effort_bound;
-      add(1.0, RowKind::kBounded, joint.command.velocity, bound, 0.0);
+      const double velocity =
+          std::clamp(joint.command.velocity, -def.velocity_limit, def.velocity_limit);
+      add(1.0, RowKind::kBounded, velocity, bound, 0.0);
     } else if (joint.command.mode == JointCommandMode::kPosition) {
       // The implicit spring-damper as a soft row (Catto 2011, "Soft
       // Constraints"): v + gamma lambda = v_cmd - beta (q - q_cmd) / dt with
@@ -227,7 +242,7 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
     link.torque = bodies_[link.body].torque;
   }
   Eigen::VectorXd& efforts = efforts_scratch_;
-  CommandedEfforts(model, &efforts);
+  CommandedEfforts(model, entry.state, &efforts);
   // The last step's end (or a teleport's placement) computed them already,
   // unless Jacobians are wanted now.
   ArticulationKinematics& k = entry.kinematics;
