@@ -264,12 +264,22 @@ void ExpectSupportMatchesBruteForce(const ConvexPolyhedron& polyhedron, unsigned
         second = distance;
       }
     }
-    const int support = polyhedron.SupportVertex(direction);
-    ASSERT_GE(support, 0);
-    EXPECT_NEAR(polyhedron.vertices[support].dot(direction), best, 1e-12 * direction.norm());
-    if (best - second > 1e-9 * direction.norm()) {
-      EXPECT_EQ(support, best_vertex) << "direction " << direction.transpose();
+    // From vertex 0, and from the axis_support vertex nearest the direction.
+    for (const int support :
+         {polyhedron.SupportVertex(direction), polyhedron.SupportVertexNearAxis(direction)}) {
+      ASSERT_GE(support, 0);
+      EXPECT_NEAR(polyhedron.vertices[support].dot(direction), best, 1e-12 * direction.norm());
+      if (best - second > 1e-9 * direction.norm()) {
+        EXPECT_EQ(support, best_vertex) << "direction " << direction.transpose();
+      }
     }
+  }
+  for (int k = 0; k < 6; ++k) {
+    Vec3 axis = Vec3::Zero();
+    axis[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
+    const Vec3& support = polyhedron.vertices[polyhedron.axis_support[k]];
+    EXPECT_DOUBLE_EQ(support.dot(axis),
+                     polyhedron.vertices[polyhedron.SupportVertex(axis)].dot(axis));
   }
 }
 

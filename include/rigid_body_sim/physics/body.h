@@ -2,6 +2,7 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_BODY_H_
 #define RIGID_BODY_SIM_PHYSICS_BODY_H_
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -58,6 +59,10 @@ struct Body {
   // the travel of its two bodies since then is below g minus the contact
   // distance, with no need to look at it (World::CollideBodies).
   double travel = 0.0;
+  // Per shape, the vertices its polyhedron reached furthest along +x, -x,
+  // +y, -y, +z, -z of the world when the broad phase last boxed it: the
+  // next step's support climbs start there, a step or two from the answer.
+  std::vector<std::array<int, 6>> box_support;
 
   bool is_static = false;
   bool awake = true;

@@ -2,6 +2,7 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_CONVEX_POLYHEDRON_H_
 #define RIGID_BODY_SIM_PHYSICS_CONVEX_POLYHEDRON_H_
 
+#include <array>
 #include <vector>
 
 #include "rigid_body_sim/physics/mass_properties.h"
@@ -31,6 +32,10 @@ struct ConvexPolyhedron {
   std::vector<int> vertex_half_edge;  // one outgoing half-edge per vertex
   std::vector<Vec3> edge_directions;  // unit directions of edges, unique up to sign
   Vec3 centroid = Vec3::Zero();       // m, the volume centroid
+  // The support vertices along +x, -x, +y, -y, +z, -z of the shape frame:
+  // where a support query along a nearby direction starts its climb. Any
+  // vertices are correct starts; these make the climb a few steps.
+  std::array<int, 6> axis_support{};
 
   int EdgeCount() const { return static_cast<int>(half_edges.size() / 2); }
   static int Twin(int half_edge) { return half_edge ^ 1; }
@@ -38,6 +43,11 @@ struct ConvexPolyhedron {
   std::vector<int> FaceVertices(int face) const;
   // Index of the vertex furthest along `direction` (support mapping).
   int SupportVertex(const Vec3& direction) const;
+  // The same, climbing from vertex `start` (any vertex is correct; one near
+  // the answer is fast), or from the axis_support vertex nearest
+  // `direction`. Where several vertices are furthest, any may be returned.
+  int SupportVertexFrom(const Vec3& direction, int start) const;
+  int SupportVertexNearAxis(const Vec3& direction) const;
   TriangleMesh Triangulate() const;
 };
 

@@ -8,13 +8,25 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-Aabb BodyAabb(const Body& body) {
-  const Pose world_from_body = body.WorldFromBody();
-  Aabb box = ShapeAabb(body.shapes.front().geometry,
-                       world_from_body * body.shapes.front().body_from_shape);
-  for (std::size_t i = 1; i < body.shapes.size(); ++i) {
-    box = box.Union(
-        ShapeAabb(body.shapes[i].geometry, world_from_body * body.shapes[i].body_from_shape));
+// The union of the shapes' boxes. Each polyhedron's support climbs start
+// where the last step's ended (Body::box_support): a turning body's extreme
+// vertices move a step or two along its edges between two steps.
+Aabb BodyAabb(Body* body) {
+  if (body->box_support.size() != body->shapes.size()) {
+    body->box_support.assign(body->shapes.size(), std::array<int, 6>{});
+    for (std::size_t i = 0; i < body->shapes.size(); ++i) {
+      const auto* polyhedron =
+          std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&body->shapes[i].geometry);
+      if (polyhedron != nullptr) body->box_support[i] = (*polyhedron)->axis_support;
+    }
+  }
+  const Pose world_from_body = body->WorldFromBody();
+  Aabb box;
+  for (std::size_t i = 0; i < body->shapes.size(); ++i) {
+    const Aabb shape_box =
+        ShapeAabb(body->shapes[i].geometry, world_from_body * body->shapes[i].body_from_shape,
+                  &body->box_support[i]);
+    box = i == 0 ? shape_box : box.Union(shape_box);
   }
   return box;
 }
@@ -37,7 +49,7 @@ void WorldImpl::UpdateBroadPhase(const StepContext& step) {
     const ProxyKind kind = KindOf(body);
     const bool moving = kind == ProxyKind::kDynamic;
     if (body.has_proxy && !moving && broad_phase_.GetKind(static_cast<int>(i)) == kind) continue;
-    Aabb box = BodyAabb(body);
+    Aabb box = BodyAabb(&body);
     if (moving) {
       // The box swept over the predicted motion of the step, so that pairs
       // exist before the surfaces meet (and fast bodies cannot skip them).

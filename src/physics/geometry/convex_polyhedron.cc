@@ -13,6 +13,49 @@ namespace {
 // Up to this many vertices a linear scan beats hill climbing.
 constexpr int kLinearSupportLimit = 32;
 
+// Support mapping argmax_v d.v. On a convex polytope a vertex none of whose
+// neighbours is further along d is a global maximum (the linear function
+// has no other local maxima on the vertex graph), so steepest ascent over
+// the adjacency from vertex_half_edge finds it; each step strictly increases
+// d.v, so it terminates. Small polyhedra use a linear scan.
+int ClimbToSupport(const ConvexPolyhedron& p, const Vec3& direction, int start) {
+  assert(!p.vertices.empty());
+  const int vertex_count = static_cast<int>(p.vertices.size());
+  if (vertex_count <= kLinearSupportLimit || p.half_edges.empty()) {
+    int best = 0;
+    double best_distance = p.vertices[0].dot(direction);
+    for (int v = 1; v < vertex_count; ++v) {
+      const double distance = p.vertices[v].dot(direction);
+      if (distance > best_distance) {
+        best = v;
+        best_distance = distance;
+      }
+    }
+    return best;
+  }
+  int best = start >= 0 && start < vertex_count ? start : 0;
+  double best_distance = p.vertices[best].dot(direction);
+  for (;;) {
+    int step_to = best;
+    double step_distance = best_distance;
+    // Outgoing half-edges of a vertex: h, next(twin(h)), ...
+    const int first = p.vertex_half_edge[best];
+    int h = first;
+    do {
+      const int neighbour = p.half_edges[ConvexPolyhedron::Twin(h)].origin;
+      const double distance = p.vertices[neighbour].dot(direction);
+      if (distance > step_distance) {
+        step_to = neighbour;
+        step_distance = distance;
+      }
+      h = p.half_edges[ConvexPolyhedron::Twin(h)].next;
+    } while (h != first);
+    if (step_to == best) return best;
+    best = step_to;
+    best_distance = step_distance;
+  }
+}
+
 }  // namespace
 
 std::vector<int> ConvexPolyhedron::FaceVertices(int face) const {
@@ -27,47 +70,18 @@ std::vector<int> ConvexPolyhedron::FaceVertices(int face) const {
   return result;
 }
 
-// Support mapping argmax_v d.v. On a convex polytope a vertex none of whose
-// neighbours is further along d is a global maximum (the linear function
-// has no other local maxima on the vertex graph), so steepest ascent over
-// the adjacency from vertex_half_edge finds it; each step strictly increases
-// d.v, so it terminates. Small polyhedra use a linear scan.
 int ConvexPolyhedron::SupportVertex(const Vec3& direction) const {
-  assert(!vertices.empty());
-  const int vertex_count = static_cast<int>(vertices.size());
-  if (vertex_count <= kLinearSupportLimit || half_edges.empty()) {
-    int best = 0;
-    double best_distance = vertices[0].dot(direction);
-    for (int v = 1; v < vertex_count; ++v) {
-      const double distance = vertices[v].dot(direction);
-      if (distance > best_distance) {
-        best = v;
-        best_distance = distance;
-      }
-    }
-    return best;
-  }
-  int best = 0;
-  double best_distance = vertices[0].dot(direction);
-  for (;;) {
-    int step_to = best;
-    double step_distance = best_distance;
-    // Outgoing half-edges of a vertex: h, next(twin(h)), ...
-    const int first = vertex_half_edge[best];
-    int h = first;
-    do {
-      const int neighbour = half_edges[Twin(h)].origin;
-      const double distance = vertices[neighbour].dot(direction);
-      if (distance > step_distance) {
-        step_to = neighbour;
-        step_distance = distance;
-      }
-      h = half_edges[Twin(h)].next;
-    } while (h != first);
-    if (step_to == best) return best;
-    best = step_to;
-    best_distance = step_distance;
-  }
+  return ClimbToSupport(*this, direction, 0);
+}
+
+int ConvexPolyhedron::SupportVertexFrom(const Vec3& direction, int start) const {
+  return ClimbToSupport(*this, direction, start);
+}
+
+int ConvexPolyhedron::SupportVertexNearAxis(const Vec3& direction) const {
+  int axis = 0;
+  direction.cwiseAbs().maxCoeff(&axis);
+  return ClimbToSupport(*this, direction, axis_support[2 * axis + (direction[axis] < 0.0 ? 1 : 0)]);
 }
 
 // Fan triangulation (v0, vi, vi+1) of each convex, counter-clockwise face

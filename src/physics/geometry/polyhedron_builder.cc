@@ -505,6 +505,11 @@ Result<ConvexPolyhedron> MakeConvexPolyhedron(const std::vector<Vec3>& vertices,
   const Result<MassProperties> volume = TriangleMeshMassProperties(1.0, polyhedron.Triangulate());
   if (!volume.ok()) return Fail(volume.message());
   polyhedron.centroid = volume.value().center_of_mass;
+  for (int k = 0; k < 6; ++k) {
+    Vec3 axis = Vec3::Zero();
+    axis[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
+    polyhedron.axis_support[k] = polyhedron.SupportVertex(axis);
+  }
   return polyhedron;
 }
 

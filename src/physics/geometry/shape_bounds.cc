@@ -12,7 +12,8 @@ namespace {
 // support queries.
 constexpr std::size_t kDirectAabbVertexCount = 16;
 
-Aabb PolyhedronAabb(const ConvexPolyhedron& polyhedron, const Pose& world_from_shape) {
+Aabb PolyhedronAabb(const ConvexPolyhedron& polyhedron, const Pose& world_from_shape,
+                    std::array<int, 6>* seeds) {
   if (polyhedron.vertices.size() <= kDirectAabbVertexCount) {
     Aabb box{Vec3::Constant(std::numeric_limits<double>::infinity()),
              Vec3::Constant(-std::numeric_limits<double>::infinity())};
@@ -30,8 +31,19 @@ Aabb PolyhedronAabb(const ConvexPolyhedron& polyhedron, const Pose& world_from_s
   Aabb box;
   for (int axis = 0; axis < 3; ++axis) {
     const Vec3 axis_shape = shape_from_world.col(axis);
-    const Vec3& high = polyhedron.vertices[polyhedron.SupportVertex(axis_shape)];
-    const Vec3& low = polyhedron.vertices[polyhedron.SupportVertex(-axis_shape)];
+    int high_vertex = 0;
+    int low_vertex = 0;
+    if (seeds != nullptr) {
+      high_vertex = polyhedron.SupportVertexFrom(axis_shape, (*seeds)[2 * axis]);
+      low_vertex = polyhedron.SupportVertexFrom(-axis_shape, (*seeds)[2 * axis + 1]);
+      (*seeds)[2 * axis] = high_vertex;
+      (*seeds)[2 * axis + 1] = low_vertex;
+    } else {
+      high_vertex = polyhedron.SupportVertexNearAxis(axis_shape);
+      low_vertex = polyhedron.SupportVertexNearAxis(-axis_shape);
+    }
+    const Vec3& high = polyhedron.vertices[high_vertex];
+    const Vec3& low = polyhedron.vertices[low_vertex];
     box.max[axis] = (world_from_shape * high)[axis];
     box.min[axis] = (world_from_shape * low)[axis];
   }
@@ -40,7 +52,8 @@ Aabb PolyhedronAabb(const ConvexPolyhedron& polyhedron, const Pose& world_from_s
 
 }  // namespace
 
-Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape) {
+Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape,
+               std::array<int, 6>* support_seeds) {
   if (const auto* sphere = std::get_if<Sphere>(&geometry)) {
     const Vec3 radius = Vec3::Constant(sphere->radius);
     return Aabb{world_from_shape.translation - radius, world_from_shape.translation + radius};
@@ -67,7 +80,7 @@ Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape) {
   }
   const auto* polyhedron = std::get_if<std::shared_ptr<const ConvexPolyhedron>>(&geometry);
   assert(polyhedron != nullptr && *polyhedron != nullptr);
-  return PolyhedronAabb(**polyhedron, world_from_shape);
+  return PolyhedronAabb(**polyhedron, world_from_shape, support_seeds);
 }
 
 double ShapeThickness(const ShapeGeometry& geometry) {

@@ -3,6 +3,8 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_GEOMETRY_SHAPE_BOUNDS_H_
 #define RIGID_BODY_SIM_PHYSICS_GEOMETRY_SHAPE_BOUNDS_H_
 
+#include <array>
+
 #include "physics/geometry/aabb.h"
 #include "rigid_body_sim/physics/shape.h"
 #include "rigid_body_sim/physics/types.h"
@@ -10,8 +12,11 @@
 namespace rigid_body_sim::physics {
 
 // World box of a sphere, cylinder, polyhedron or static mesh (not a half-space,
-// which is unbounded).
-Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape);
+// which is unbounded). A polyhedron's support climbs start from
+// `support_seeds` (Body::box_support) when given, and leave their answers
+// there; from its axis_support vertices otherwise.
+Aabb ShapeAabb(const ShapeGeometry& geometry, const Pose& world_from_shape,
+               std::array<int, 6>* support_seeds = nullptr);
 
 // Smallest width of the shape over all directions (m): 2r for a sphere; for a
 // polyhedron the smallest extent along a face normal, which is the minimum
