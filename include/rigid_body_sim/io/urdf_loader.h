@@ -25,10 +25,11 @@
 namespace rigid_body_sim::io {
 
 // Movable joints of one articulated model by default (~max_joints_per_model):
-// a step costs about n (the articulated-body algorithm), and a 250-joint
-// chain's worst step (a swinging heavy tip, the energy balance split 64
-// times) takes 37 ms on the reference machine (docs/limits.md), so no call
-// waits 100 ms behind one step.
+// a free step costs about n (the articulated-body algorithm), a constrained
+// one n^3 (its joint-space inertia factored); a 250-joint chain's worst free
+// step (a swinging heavy tip, split by the energy balance) takes 21 ms and a
+// 250-joint rope lying on the ground 20 ms on the reference machine
+// (docs/limits.md), so no call waits 100 ms behind one step.
 inline constexpr int kDefaultMaxJointsPerModel = 250;
 
 // Limits on collision geometry: every size of a box, cylinder, sphere or
