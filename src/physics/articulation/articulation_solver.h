@@ -71,6 +71,7 @@ struct ConstraintRow {
   // its impulse has as the joint's effort.
   int articulation = -1;
   int joint = -1;
+  int joint_role = -1;  // its JointRowRole (articulation_system.h)
   double joint_sign = 1.0;
   double inverse_mass = 0.0;  // 1 / (J M^-1 J^T + gamma), set by Solve
 };

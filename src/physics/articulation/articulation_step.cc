@@ -111,20 +111,24 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
     // (a flap on a resting box, tipped by the ground's support, sank 3e-4
     // rad past its limit and was pulled back every third step).
     const double reach = dt * (std::abs(u) + std::abs(u - entry.state.u[column])) + kLimitTolerance;
-    auto add = [&](double sign, RowKind kind, double target, double bound, double softness) {
-      rows->push_back({static_cast<int>(j), column, sign, kind, target, bound, softness});
+    auto add = [&](JointRowRole role, double sign, RowKind kind, double target, double bound,
+                   double softness) {
+      rows->push_back({static_cast<int>(j), column, sign, kind, target, bound, softness, role});
     };
-    if (q + dt * u < def.lower + reach) add(1.0, RowKind::kNormal, (def.lower - q) / dt, 0.0, 0.0);
-    if (q + dt * u > def.upper - reach) add(-1.0, RowKind::kNormal, (q - def.upper) / dt, 0.0, 0.0);
+    if (q + dt * u < def.lower + reach)
+      add(kLowerLimitRow, 1.0, RowKind::kNormal, (def.lower - q) / dt, 0.0, 0.0);
+    if (q + dt * u > def.upper - reach)
+      add(kUpperLimitRow, -1.0, RowKind::kNormal, (q - def.upper) / dt, 0.0, 0.0);
     // A motor or servo drives no faster than the joint's speed limit; a limp
     // joint, or one given an effort, is not held to it (as in Gazebo,
     // Bullet and MuJoCo: a limp arm falls freely).
     const bool driven = joint.command.mode == JointCommandMode::kVelocity ||
                         joint.command.mode == JointCommandMode::kPosition;
     if (driven && std::abs(u) > def.velocity_limit) {
-      add(u > 0.0 ? -1.0 : 1.0, RowKind::kNormal, -def.velocity_limit, 0.0, 0.0);
+      add(u > 0.0 ? kForwardSpeedRow : kBackwardSpeedRow, u > 0.0 ? -1.0 : 1.0, RowKind::kNormal,
+          -def.velocity_limit, 0.0, 0.0);
     }
-    if (def.friction > 0.0) add(1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
+    if (def.friction > 0.0) add(kFrictionRow, 1.0, RowKind::kBounded, 0.0, def.friction * dt, 0.0);
     // Each of the joints the dof moves may exert its own limit.
     const double effort_bound = joint.effort_scale * def.effort_limit * dt;
     if (joint.command.mode == JointCommandMode::kVelocity) {
@@ -134,7 +138,7 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
                                : effort_bound;
       const double velocity =
           std::clamp(joint.command.velocity, -def.velocity_limit, def.velocity_limit);
-      add(1.0, RowKind::kBounded, velocity, bound, 0.0);
+      add(kDriveRow, 1.0, RowKind::kBounded, velocity, bound, 0.0);
     } else if (joint.command.mode == JointCommandMode::kPosition) {
       // The implicit spring-damper as a soft row (Catto 2011, "Soft
       // Constraints"): v + gamma lambda = v_cmd - beta (q - q_cmd) / dt with
@@ -144,7 +148,7 @@ void JointRowsOf(const ArticulationEntry& entry, const Eigen::VectorXd& u_free, 
       const double beta = dt * gains.stiffness / kc;
       const double gamma = 1.0 / (dt * kc);
       const double target = joint.command.velocity - beta * (q - joint.command.position) / dt;
-      add(1.0, RowKind::kBounded, target, effort_bound, gamma);
+      add(kDriveRow, 1.0, RowKind::kBounded, target, effort_bound, gamma);
     }
   }
 }
@@ -173,13 +177,20 @@ void ArticulationSystem::TakeLinkPairs(const std::vector<ShapePairContact*>& tou
   }
 }
 
+// Each row starts from the impulse its joint's row of the same role ended
+// the last step with: a held arm's servos carry the same load step after
+// step, and from zero the sweeps took tens of passes to find it again.
 void ArticulationSystem::AddArticulationRows(std::uint32_t index, int slot,
                                              const std::vector<JointRowSpec>& specs) {
-  const int n = articulations_[index].model.DofCount();
+  ArticulationEntry& entry = articulations_[index];
+  const int n = entry.model.DofCount();
+  entry.joint_row_impulses.resize(entry.model.joints.size() * kJointRowRoles, 0.0);
   for (const JointRowSpec& spec : specs) {
     ConstraintRow row;
     row.articulation = static_cast<int>(index);
     row.joint = spec.joint;
+    row.joint_role = spec.role;
+    row.impulse = entry.joint_row_impulses[spec.joint * kJointRowRoles + spec.role];
     row.joint_sign = spec.sign;
     row.a = solver_.ArticulationSide(slot, Unit(n, spec.column, spec.sign));
     row.kind = spec.kind;
@@ -285,10 +296,14 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
 void ArticulationSystem::RecordJointEfforts(const StepContext& step) {
   // A joint's effort: its command's, its rows' impulses over dt, less its
   // damping; shared with its mimics, each taking its multiplier's part.
+  for (ArticulationEntry& entry : articulations_) {
+    std::fill(entry.joint_row_impulses.begin(), entry.joint_row_impulses.end(), 0.0);
+  }
   for (const ConstraintRow& row : solver_.rows()) {
     if (row.joint < 0) continue;
     ArticulationEntry& entry = articulations_[row.articulation];
     entry.model.joints[row.joint].effort += row.joint_sign * row.impulse / step.dt;
+    entry.joint_row_impulses[row.joint * kJointRowRoles + row.joint_role] = row.impulse;
   }
   for (ArticulationEntry& entry : articulations_) {
     if (!entry.in_use) continue;

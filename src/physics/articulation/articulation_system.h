@@ -40,6 +40,17 @@ class LinkBodies {
   ~LinkBodies() = default;
 };
 
+// What a joint's row does; a joint has at most one row of each.
+enum JointRowRole : int {
+  kLowerLimitRow,
+  kUpperLimitRow,
+  kForwardSpeedRow,   // holds u <= the speed limit
+  kBackwardSpeedRow,  // holds u >= -the speed limit
+  kFrictionRow,
+  kDriveRow,  // the command's motor or servo
+  kJointRowRoles
+};
+
 // One joint row before it has a solver slot: the row on its dof `column`
 // (sign: +1 pushes the joint forward), as ConstraintRow's fields.
 struct JointRowSpec {
@@ -50,6 +61,7 @@ struct JointRowSpec {
   double target = 0.0;  // velocity units of the row
   double bound = 0.0;   // |impulse| <= bound (kBounded)
   double softness = 0.0;
+  JointRowRole role = kDriveRow;
 };
 
 // An articulation in the world: its model, its state, and the state its
@@ -66,6 +78,9 @@ struct ArticulationEntry {
   bool next_kinematics_current = false;
   ServoGains gains;
   FreeMotionIntegrator free_motion;
+  // The impulse each joint row ended its last step with, per joint and
+  // JointRowRole (0 for a row it did not have): the next step's warm start.
+  std::vector<double> joint_row_impulses;
   bool in_use = false;
   std::uint32_t generation = 0;
 };
