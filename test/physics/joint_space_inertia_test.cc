@@ -175,6 +175,47 @@ TEST(JointSpaceInertiaTest, ArticulatedBodyAlgorithmMatchesTheCompositeRigidBody
 
 // A single link turning about an axis through its hinge: M = I_axis + m d^2,
 // the parallel-axis theorem, with d the centre's distance from the axis.
+// A contact row from the joints on the link's path to the base against the
+// link's dense Jacobian, J_v^T d + J_w^T ((p - c) x d), on random trees with
+// mimics (which share their leader's column), fixed and floating, and its
+// dot with u against d . (v_c + omega x (p - c)) from the kinematics.
+TEST(JointSpaceInertiaTest, PointVelocityRowMatchesTheLinkJacobian) {
+  std::mt19937 random(20261202);
+  int compared = 0;
+  for (const bool floating : {false, true}) {
+    for (const int links : {2, 7, 31}) {
+      for (const Vec3& where : {Vec3(0.0, 0.0, 1.0), Vec3(150.0, -80.0, 20.0)}) {
+        const ArticulationModel model = RandomTree(links, floating, &random);
+        const ArticulationState state = RandomState(model, where, &random);
+        ArticulationKinematics kinematics;
+        ComputeKinematics(model, state, &kinematics, KinematicsParts::kWithJacobians);
+        for (int link = 0; link < links; ++link) {
+          const Vec3 point = kinematics.com_world[link] + RandomVector(&random, 0.4);
+          const Vec3 direction = RandomVector(&random, 1.0).normalized();
+          const JacobianRows& jacobian = kinematics.jacobian[link];
+          const Eigen::VectorXd reference =
+              jacobian.topRows<3>().transpose() * direction +
+              jacobian.bottomRows<3>().transpose() *
+                  (point - kinematics.com_world[link]).cross(direction);
+          Eigen::VectorXd row;
+          PointVelocityRow(model, kinematics, {link, point, direction}, &row);
+          ASSERT_EQ(row.size(), model.DofCount());
+          const double scale = std::max(reference.cwiseAbs().maxCoeff(), 1.0);
+          EXPECT_LT((row - reference).cwiseAbs().maxCoeff(), 1e-12 * scale)
+              << links << " links, floating " << floating << ", link " << link;
+          const Vec3 velocity =
+              kinematics.linear_velocity[link] +
+              kinematics.angular_velocity[link].cross(point - kinematics.com_world[link]);
+          EXPECT_NEAR(row.dot(state.u), direction.dot(velocity),
+                      1e-12 * scale * std::max(state.u.norm(), 1.0));
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * 2 * (2 + 7 + 31));
+}
+
 TEST(JointSpaceInertiaTest, OneHingeGivesTheParallelAxisTheorem) {
   ArticulationModel model;
   ArticulationLink base;

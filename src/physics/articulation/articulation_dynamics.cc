@@ -11,8 +11,15 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-// The dof a joint's velocity comes from, and the factor: a mimic joint moves
-// with its leader's dof.
+// The child link frame in the joint frame: a turn about the axis or a slide
+// along it.
+Pose JointMotion(const JointDef& def, double position) {
+  if (def.type == JointType::kPrismatic) return Pose{def.axis * position, Quat::Identity()};
+  return Pose{Vec3::Zero(), Quat(Eigen::AngleAxisd(position, def.axis))};
+}
+
+}  // namespace
+
 int DrivingDof(const ArticulationModel& model, int joint, double* factor) {
   const ArticulationJoint& j = model.joints[joint];
   if (j.dof >= 0) {
@@ -23,14 +30,26 @@ int DrivingDof(const ArticulationModel& model, int joint, double* factor) {
   return model.joints[j.def.mimic_joint].dof;
 }
 
-// The child link frame in the joint frame: a turn about the axis or a slide
-// along it.
-Pose JointMotion(const JointDef& def, double position) {
-  if (def.type == JointType::kPrismatic) return Pose{def.axis * position, Quat::Identity()};
-  return Pose{Vec3::Zero(), Quat(Eigen::AngleAxisd(position, def.axis))};
+void PointVelocityRow(const ArticulationModel& model, const ArticulationKinematics& k,
+                      const LinkPoint& at, Eigen::VectorXd* row) {
+  row->setZero(model.DofCount());
+  for (int link = at.link; model.links[link].parent_joint >= 0;) {
+    const int j = model.links[link].parent_joint;
+    const JointDef& def = model.joints[j].def;
+    double factor = 1.0;
+    const int column = model.base_dofs + DrivingDof(model, j, &factor);
+    const Vec3& axis = k.joint_axis_world[j];
+    const double along = def.type == JointType::kPrismatic
+                             ? at.direction.dot(axis)
+                             : at.direction.dot(axis.cross(at.point - k.joint_anchor_world[j]));
+    (*row)[column] += factor * along;
+    link = def.parent_link;
+  }
+  if (model.base_dofs == 6) {
+    row->head<3>() = at.direction;
+    row->segment<3>(3) = (at.point - k.com_world[0]).cross(at.direction);
+  }
 }
-
-}  // namespace
 
 double JointPosition(const ArticulationModel& model, const ArticulationState& state, int joint) {
   const ArticulationJoint& j = model.joints[joint];

@@ -84,6 +84,26 @@ struct ArticulationKinematics {
 // Whether any joint has damping (B != 0).
 bool AnyJointDamped(const ArticulationModel& model);
 
+// The dof a joint's velocity comes from, and the factor: a mimic joint moves
+// with its leader's dof, times its multiplier.
+int DrivingDof(const ArticulationModel& model, int joint, double* factor);
+
+// A point fixed to a link, and a direction: what a contact row reads.
+struct LinkPoint {
+  int link = 0;
+  Vec3 point = Vec3::Zero();      // m, world
+  Vec3 direction = Vec3::Zero();  // world
+};
+
+// The row r with r . u = d . (velocity of the point): for each joint on the
+// path from the link to the base, d . (s x (p - a)) for a turn about s
+// through a, d . s for a slide (a mimic's on its leader's dof, times its
+// multiplier); for a floating base, d on its centre's velocity and
+// (p - c) x d on its angular velocity. O(depth), from the kinematics'
+// poses; the links' dense Jacobians cost O(n^2) for one row.
+void PointVelocityRow(const ArticulationModel& model, const ArticulationKinematics& kinematics,
+                      const LinkPoint& at, Eigen::VectorXd* row);
+
 // A joint's position and velocity from the state (mimic joints follow their
 // leader).
 double JointPosition(const ArticulationModel& model, const ArticulationState& state, int joint);

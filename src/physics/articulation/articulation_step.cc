@@ -254,13 +254,10 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
   }
   Eigen::VectorXd& efforts = efforts_scratch_;
   CommandedEfforts(model, entry.state, &efforts);
-  // The last step's end (or a teleport's placement) computed them already,
-  // unless Jacobians are wanted now.
+  // The last step's end (or a teleport's placement) computed them already.
   ArticulationKinematics& k = entry.kinematics;
-  if (!entry.kinematics_current || (touched && k.jacobian.empty())) {
-    ComputeKinematics(
-        model, entry.state, &k,
-        touched ? KinematicsParts::kWithJacobians : KinematicsParts::kPosesAndVelocities);
+  if (!entry.kinematics_current) {
+    ComputeKinematics(model, entry.state, &k, KinematicsParts::kPosesAndVelocities);
     entry.kinematics_current = true;
   }
   entry.next_kinematics_current = false;

@@ -18,12 +18,9 @@ double ArticulationSystem::StartPointVelocity(std::uint32_t index, const Vec3& d
   const Body& body = bodies_[index];
   const Vec3 r = point - body.position;
   if (body.articulation >= 0) {
-    const ArticulationEntry& entry = articulations_[body.articulation];
-    const JacobianRows& jacobian = entry.kinematics.jacobian[body.link];
-    const Eigen::VectorXd& u = articulations_[body.articulation].state.u;
-    const Vec3 linear = jacobian.topRows<3>() * u;
-    const Vec3 angular = jacobian.bottomRows<3>() * u;
-    return direction.dot(linear + angular.cross(r));
+    // The link's velocity in the kinematics of the state the step starts from.
+    const ArticulationKinematics& k = articulations_[body.articulation].kinematics;
+    return direction.dot(k.linear_velocity[body.link] + k.angular_velocity[body.link].cross(r));
   }
   if (body.is_static || !body.awake || body.disabled) return 0.0;
   const Vec3 angular = body.inverse_inertia_world * body.start_angular_momentum;
@@ -31,19 +28,17 @@ double ArticulationSystem::StartPointVelocity(std::uint32_t index, const Vec3& d
 }
 
 // One side of a link-contact row along `direction` at `point`: a link's
-// through its Jacobian (J_v^T d + J_w^T (r x d)), a rigid body's through
-// its mass and inertia (a static or resting one has none).
+// through the joints on its path to the base (PointVelocityRow), a rigid
+// body's through its mass and inertia (a static or resting one has none).
 RowSide ArticulationSystem::LinkContactSide(const std::vector<int>& slot_of_articulation,
                                             std::uint32_t index, const Vec3& direction,
                                             const Vec3& point) {
   const Body& body = bodies_[index];
   if (body.articulation >= 0) {
-    const int articulation_slot = slot_of_articulation[body.articulation];
-    const JacobianRows& jacobian = articulations_[body.articulation].kinematics.jacobian[body.link];
-    const Vec3 r = point - body.position;
-    const Eigen::VectorXd row = jacobian.topRows<3>().transpose() * direction +
-                                jacobian.bottomRows<3>().transpose() * r.cross(direction);
-    return solver_.ArticulationSide(articulation_slot, row);
+    const ArticulationEntry& entry = articulations_[body.articulation];
+    Eigen::VectorXd row;
+    PointVelocityRow(entry.model, entry.kinematics, {body.link, point, direction}, &row);
+    return solver_.ArticulationSide(slot_of_articulation[body.articulation], row);
   }
   ArticulationSolver::BodySlot body_slot;
   body_slot.body = index;
