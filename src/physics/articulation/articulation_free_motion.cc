@@ -131,6 +131,12 @@ void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd&
   }
 }
 
+void FreeMotionIntegrator::Restart() {
+  parts_ = 1;
+  last_ratio_ = 1.0;
+  steps_before_retry_ = 0;
+}
+
 void FreeMotionIntegrator::StepInParts(const FreeMotionStep& step, int parts,
                                        ArticulationState* next) {
   const double h = step.dt / parts;

@@ -46,7 +46,7 @@ Eigen::VectorXd Unit(int size, int index, double sign) {
 // command clamped to its limit, which its mimics exert too (scaled by their
 // multipliers), so a dof with mimics gets effort_scale times it. As
 // Gazebo's Joint::CheckAndTruncateForce does, an effort that would drive a
-// joint at or past its speed limit further is not applied: the URDF's
+// joint already past its speed limit further is not applied: the URDF's
 // velocity limit bounds what the joint's actuator drives, not its passive
 // motion.
 void CommandedEfforts(const ArticulationModel& model, const ArticulationState& state,

@@ -2,6 +2,7 @@
 // commands, and moving a whole articulation when one of its links is set.
 #include "physics/articulation/articulation_system.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -267,7 +268,7 @@ Status ArticulationSystem::SetJointStates(ArticulationId id, const std::vector<d
   }
   entry.state = state;
   entry.next = state;
-  entry.kinematics_current = false;
+  Teleported(&entry);
   PlaceLinks(id.index, /*restart=*/true);
   return Status::Ok();
 }
@@ -332,13 +333,22 @@ Status ArticulationSystem::MoveWithLink(std::uint32_t index, const Pose& world_f
   }
   entry.state = state;
   entry.next = state;
-  entry.kinematics_current = false;
+  Teleported(&entry);
   PlaceLinks(index, /*restart=*/true);
   return Status::Ok();
 }
 
 // Puts every link body where the state says, with its velocity. A restart
 // (a teleport) also forgets the links' contacts and wakes what touched them.
+// A state set from outside starts the articulation over: its kinematics
+// are stale, and the splits and joint-row impulses of the motion it left
+// are not this one's, so that a reset replays its first run bit for bit.
+void ArticulationSystem::Teleported(ArticulationEntry* entry) {
+  entry->kinematics_current = false;
+  entry->free_motion.Restart();
+  std::fill(entry->joint_row_impulses.begin(), entry->joint_row_impulses.end(), 0.0);
+}
+
 void ArticulationSystem::PlaceLinks(std::uint32_t index, bool restart) {
   ArticulationEntry& entry = articulations_[index];
   if (!entry.kinematics_current) {

@@ -128,6 +128,7 @@ class ArticulationSystem {
   static constexpr int kMaxSweeps = 200;
   static constexpr double kSweepTolerance = 1e-9;
 
+  static void Teleported(ArticulationEntry* entry);
   // Places the links where entry.state says (from its kinematics, computed
   // if they are not current).
   void PlaceLinks(std::uint32_t index, bool restart);

@@ -48,6 +48,9 @@ class FreeMotionIntegrator {
   static constexpr int kMaxParts = 64;
 
   void Step(const FreeMotionStep& step, const FreeMotionEnd& end);
+  // Forgets the splits the last steps needed (a teleport), keeping the
+  // buffers: the next step starts as the first did.
+  void Restart();
   // RK4 steps the last step took.
   int parts() const { return parts_; }
 
