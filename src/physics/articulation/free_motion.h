@@ -36,13 +36,14 @@ struct FreeMotionEnd {
 // The free motion of one articulation, step after step. A step is one RK4
 // step, or 2, 4, ... up to kMaxParts equal ones where the whole step would
 // miss the energy balance E1 = E0 + W (the efforts' work W) by more than
-// 1e-5 of the kinetic energy; what is left of the miss is then
-// projected away by scaling u. A step starts from the last one's split, or
-// half of it when the last miss, grown as RK4's error grows, would pass. Without joint damping or
-// wrenches on the links the energy is kept to rounding; with damping the balance is a bound (E1 <=
-// E0 + W), and only a gain is projected away. With wrenches on links the balance is not checked.
-// Its buffers keep their size from step to step, so that a step allocates nothing once they have
-// their model's.
+// 1e-4 of the kinetic energy; what is left of the miss is then projected
+// away by scaling u. A step starts from the last one's split, or half of
+// it when the last miss, grown as RK4's error grows, would pass. Without
+// joint damping or wrenches on the links the energy is kept to rounding;
+// with damping the balance is a bound (E1 <= E0 + W), and only a gain is
+// projected away. With wrenches on links the balance is not checked. Its
+// buffers keep their size from step to step, so that a step allocates
+// nothing once they have their model's.
 class FreeMotionIntegrator {
  public:
   static constexpr int kMaxParts = 64;
