@@ -16,7 +16,9 @@
 // kinetic energy's metric). Damping only takes energy out, so with it the
 // balance is a bound, E1 <= E0 + W, and only a gain is projected away.
 // With external wrenches on links the balance is not checked; the step then
-// keeps the split its last checked steps needed.
+// keeps the split its last checked steps needed. A step's parts are capped
+// by a budget of parts times links (MostParts): past it the projection
+// still keeps the energy, and a large model's step its bounded cost.
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -83,8 +85,16 @@ void ScaleVelocities(double s, ArticulationKinematics* k) {
 
 }  // namespace
 
+int FreeMotionIntegrator::MostParts(const ArticulationModel& model) {
+  const std::size_t moving = model.links.size() - (model.fixed_base ? 1 : 0);
+  int parts = kMaxParts;
+  while (parts > 1 && static_cast<std::size_t>(parts) * moving > kLinkPartBudget) parts /= 2;
+  return parts;
+}
+
 void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd& end) {
-  parts_ = std::clamp(parts_, 1, kMaxParts);
+  const int most_parts = MostParts(step.model);
+  parts_ = std::clamp(parts_, 1, most_parts);
   if (WrenchesOnLinks(step.model)) {
     StepInParts(step, parts_, end.state);
     ComputeKinematics(step.model, *end.state, end.kinematics, KinematicsParts::kPosesAndVelocities);
@@ -107,7 +117,7 @@ void FreeMotionIntegrator::Step(const FreeMotionStep& step, const FreeMotionEnd&
     const double tolerance = kBalanceTolerance * std::max(before.kinetic, after.kinetic) + rounding;
     const double error = exact_balance ? std::abs(miss) : miss;
     // Written so that a state that is not finite (NaN miss) is split too.
-    if (!(error <= tolerance) && parts_ < kMaxParts) {
+    if (!(error <= tolerance) && parts_ < most_parts) {
       parts_ *= 2;
       if (fewer) steps_before_retry_ = kStepsBeforeRetry;
       fewer = false;

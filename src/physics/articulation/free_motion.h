@@ -34,10 +34,12 @@ struct FreeMotionEnd {
 };
 
 // The free motion of one articulation, step after step. A step is one RK4
-// step, or 2, 4, ... up to kMaxParts equal ones where the whole step would
+// step, or 2, 4, ... up to MostParts equal ones where the whole step would
 // miss the energy balance E1 = E0 + W (the efforts' work W) by more than
 // 1e-4 of the kinetic energy; what is left of the miss is then projected
-// away by scaling u. A step starts from the last one's split, or half of
+// away by scaling u. At MostParts the step is taken whatever its miss: a
+// large model's cost per step is bounded, and it is its accuracy, not its
+// energy, that gives way. A step starts from the last one's split, or half of
 // it when the last miss, grown as RK4's error grows, would pass. Without
 // joint damping or wrenches on the links the energy is kept to rounding;
 // with damping the balance is a bound (E1 <= E0 + W), and only a gain is
@@ -47,6 +49,13 @@ struct FreeMotionEnd {
 class FreeMotionIntegrator {
  public:
   static constexpr int kMaxParts = 64;
+  // The most RK4 parts times moving links one step may spend: about 4 ms
+  // on this project's machines (1 us per link and part), so that a
+  // 1000-link chain steps in a few milliseconds whatever its motion needs.
+  static constexpr std::size_t kLinkPartBudget = 4096;
+  // The most parts a step of `model` may take: kMaxParts, halved while
+  // parts times moving links exceed kLinkPartBudget (at least 1).
+  static int MostParts(const ArticulationModel& model);
 
   void Step(const FreeMotionStep& step, const FreeMotionEnd& end);
   // Forgets the splits the last steps needed (a teleport), keeping the
