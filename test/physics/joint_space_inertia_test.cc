@@ -173,13 +173,81 @@ TEST(JointSpaceInertiaTest, ArticulatedBodyAlgorithmMatchesTheCompositeRigidBody
   EXPECT_EQ(compared, 40);
 }
 
-// A single link turning about an axis through its hinge: M = I_axis + m d^2,
-// the parallel-axis theorem, with d the centre's distance from the axis.
-// A contact row from the joints on the link's path to the base against the
-// link's dense Jacobian, J_v^T d + J_w^T ((p - c) x d), on random trees with
-// mimics (which share their leader's column), fixed and floating, and its
-// dot with u against d . (v_c + omega x (p - c)) from the kinematics.
-TEST(JointSpaceInertiaTest, PointVelocityRowMatchesTheLinkJacobian) {
+// The row solve's M^-1 J^T of a large model from the articulated-body
+// passes (ArticulatedResponse) against the dense factor of M + h B, for
+// generalized forces of every kind: a joint's unit, a point force's row on
+// a random link, and a random vector; fixed and floating bases, h = 0 and
+// 1/240 s with damped joints.
+TEST(JointSpaceInertiaTest, ArticulatedResponseMatchesTheDenseFactor) {
+  std::mt19937 random(20261203);
+  int compared = 0;
+  for (const bool floating : {false, true}) {
+    for (const int links : {2, 5, 16, 40}) {
+      for (const double damping_step : {0.0, 1.0 / 240.0}) {
+        const ArticulationModel model = RandomTree(links, floating, &random, /*mimics=*/false);
+        const ArticulationState state = RandomState(model, Vec3(3.0, -2.0, 1.0), &random);
+        ArticulationKinematics kinematics;
+        ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
+        const Eigen::VectorXd efforts = Eigen::VectorXd::Zero(model.joint_dofs);
+        ArticulatedBodyScratch scratch;
+        Eigen::VectorXd acceleration;
+        ArticulatedBodyForwardDynamics(
+            {model, state, kinematics, Vec3(0, 0, -9.81), efforts, damping_step}, &scratch,
+            &acceleration);
+        ArticulatedResponse response;
+        response.Capture(model, scratch);
+        Eigen::MatrixXd mass;
+        JointSpaceInertia(model, kinematics, &mass);
+        for (const ArticulationJoint& joint : model.joints) {
+          mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) +=
+              damping_step * joint.def.damping;
+        }
+        const Eigen::LLT<Eigen::MatrixXd> factor(mass);
+        std::vector<Eigen::VectorXd> forces;
+        forces.push_back(Eigen::VectorXd::Unit(model.DofCount(), model.DofCount() - 1));
+        const int link = std::uniform_int_distribution<int>(1, links - 1)(random);
+        const Vec3 point = kinematics.com_world[link] + RandomVector(&random, 0.2);
+        std::array<Eigen::VectorXd, 3> rows;
+        PointVelocityRows(model, kinematics,
+                          {link, point, {RandomVector(&random, 1.0), Vec3::Zero(), Vec3::Zero()}},
+                          &rows);
+        forces.push_back(rows[0]);
+        forces.push_back(Eigen::VectorXd::Random(model.DofCount()));
+        std::array<Eigen::VectorXd, 3> together;
+        response.ApplyThree({&forces[0], &forces[1], &forces[2]}, model.DofCount(),
+                            {&together[0], &together[1], &together[2]});
+        for (int f = 0; f < 3; ++f) {
+          const Eigen::VectorXd& force = forces[f];
+          const Eigen::VectorXd reference = factor.solve(force);
+          // Alone over the whole u, alone from its last nonzero entry (the
+          // joints past it skipped), and with the other two.
+          Eigen::Index extent = force.size();
+          while (extent > 0 && force[extent - 1] == 0.0) --extent;
+          std::array<Eigen::VectorXd, 3> fast;
+          response.Apply(force, force.size(), &fast[0]);
+          response.Apply(force, extent, &fast[1]);
+          fast[2] = together[f];
+          for (const Eigen::VectorXd& candidate : fast) {
+            ASSERT_EQ(candidate.size(), reference.size());
+            EXPECT_LT((candidate - reference).cwiseAbs().maxCoeff(),
+                      1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
+                << links << " links, floating " << floating << ", h " << damping_step << ", force "
+                << f;
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 144);
+}
+
+// A contact point's three rows from the joints on the link's path to the
+// base against the link's dense Jacobian, J_v^T d + J_w^T ((p - c) x d), on
+// random trees with mimics (which share their leader's column), fixed and
+// floating, and their dots with u against d . (v_c + omega x (p - c)) from
+// the kinematics.
+TEST(JointSpaceInertiaTest, PointVelocityRowsMatchTheLinkJacobian) {
   std::mt19937 random(20261202);
   int compared = 0;
   for (const bool floating : {false, true}) {
@@ -191,31 +259,38 @@ TEST(JointSpaceInertiaTest, PointVelocityRowMatchesTheLinkJacobian) {
         ComputeKinematics(model, state, &kinematics, KinematicsParts::kWithJacobians);
         for (int link = 0; link < links; ++link) {
           const Vec3 point = kinematics.com_world[link] + RandomVector(&random, 0.4);
-          const Vec3 direction = RandomVector(&random, 1.0).normalized();
+          std::array<Vec3, 3> directions;
+          for (Vec3& direction : directions) direction = RandomVector(&random, 1.0).normalized();
+          std::array<Eigen::VectorXd, 3> rows;
+          PointVelocityRows(model, kinematics, {link, point, directions}, &rows);
           const JacobianRows& jacobian = kinematics.jacobian[link];
-          const Eigen::VectorXd reference =
-              jacobian.topRows<3>().transpose() * direction +
-              jacobian.bottomRows<3>().transpose() *
-                  (point - kinematics.com_world[link]).cross(direction);
-          Eigen::VectorXd row;
-          PointVelocityRow(model, kinematics, {link, point, direction}, &row);
-          ASSERT_EQ(row.size(), model.DofCount());
-          const double scale = std::max(reference.cwiseAbs().maxCoeff(), 1.0);
-          EXPECT_LT((row - reference).cwiseAbs().maxCoeff(), 1e-12 * scale)
-              << links << " links, floating " << floating << ", link " << link;
-          const Vec3 velocity =
-              kinematics.linear_velocity[link] +
-              kinematics.angular_velocity[link].cross(point - kinematics.com_world[link]);
-          EXPECT_NEAR(row.dot(state.u), direction.dot(velocity),
-                      1e-12 * scale * std::max(state.u.norm(), 1.0));
-          ++compared;
+          for (int r = 0; r < 3; ++r) {
+            const Vec3& direction = directions[r];
+            const Eigen::VectorXd reference =
+                jacobian.topRows<3>().transpose() * direction +
+                jacobian.bottomRows<3>().transpose() *
+                    (point - kinematics.com_world[link]).cross(direction);
+            const Eigen::VectorXd& row = rows[r];
+            ASSERT_EQ(row.size(), model.DofCount());
+            const double scale = std::max(reference.cwiseAbs().maxCoeff(), 1.0);
+            EXPECT_LT((row - reference).cwiseAbs().maxCoeff(), 1e-12 * scale)
+                << links << " links, floating " << floating << ", link " << link;
+            const Vec3 velocity =
+                kinematics.linear_velocity[link] +
+                kinematics.angular_velocity[link].cross(point - kinematics.com_world[link]);
+            EXPECT_NEAR(row.dot(state.u), direction.dot(velocity),
+                        1e-12 * scale * std::max(state.u.norm(), 1.0));
+            ++compared;
+          }
         }
       }
     }
   }
-  EXPECT_EQ(compared, 2 * 2 * (2 + 7 + 31));
+  EXPECT_EQ(compared, 3 * 2 * 2 * (2 + 7 + 31));
 }
 
+// A single link turning about an axis through its hinge: M = I_axis + m d^2,
+// the parallel-axis theorem, with d the centre's distance from the axis.
 TEST(JointSpaceInertiaTest, OneHingeGivesTheParallelAxisTheorem) {
   ArticulationModel model;
   ArticulationLink base;

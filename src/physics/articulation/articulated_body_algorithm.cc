@@ -166,6 +166,104 @@ void ArticulatedBodyForwardDynamics(const ForwardDynamicsInput& in, ArticulatedB
   }
 }
 
+void ArticulatedResponse::Capture(const ArticulationModel& model,
+                                  const ArticulatedBodyScratch& scratch) {
+  base_dofs_ = model.base_dofs;
+  dof_count_ = model.DofCount();
+  const std::size_t joints = model.joints.size();
+  edges_.resize(joints);
+  scaled_.resize(joints);
+  inverse_pivot_.resize(joints);
+  for (std::size_t j = 0; j < joints; ++j) {
+    const ArticulationJoint& joint = model.joints[j];
+    edges_[j] = {joint.def.parent_link, joint.def.child_link, model.base_dofs + joint.dof};
+    inverse_pivot_[j] = 1.0 / scratch.pivot[j];
+    scaled_[j] = scratch.inertia_subspace[j] * inverse_pivot_[j];
+  }
+  subspace_.assign(scratch.subspace.begin(), scratch.subspace.end());
+  if (model.base_dofs == 6) base_inertia_.compute(scratch.inertia[0]);
+  const std::size_t links = model.links.size();
+  bias_one_.resize(links);
+  acceleration_one_.resize(links);
+  bias_three_.resize(links);
+  acceleration_three_.resize(links);
+  remainder_.resize(3 * joints);
+}
+
+void ArticulatedResponse::Apply(const Eigen::VectorXd& force, Eigen::Index extent,
+                                Eigen::VectorXd* response) {
+  Passes<1>({&force}, extent, {response}, &bias_one_, &acceleration_one_);
+}
+
+void ArticulatedResponse::ApplyThree(const std::array<const Eigen::VectorXd*, 3>& forces,
+                                     Eigen::Index extent,
+                                     const std::array<Eigen::VectorXd*, 3>& responses) {
+  Passes<3>(forces, extent, responses, &bias_three_, &acceleration_three_);
+}
+
+// The articulated-body algorithm's passes 2 and 3 with every velocity and
+// gravity zero, so that c_i = 0 and p_i = -f_i: only the generalized force
+// Q drives them, and the inertias (U, D, I^A_0) are the evaluation's:
+//   pass 2 (in):   u_i = Q_i - S_i . p_i,  p_p += p_i + (U_i / D_i) u_i;
+//   pass 3 (out):  qddot_i = u_i / D_i - (U_i / D_i) . a_p,
+//                  a_i = a_p + S_i qddot_i,
+// with a_0 = -(I^A_0)^-1 p_0 for a floating base, whose Q is (f, n), its
+// force and its torque about its centre, in the order of its u = (v_com,
+// omega). The result is (M + h B)^-1 Q exactly (Featherstone 2008, section
+// 7.3; the same passes give the test-impulse responses of Mirtich 1996,
+// "Impulse-based Dynamic Simulation of Rigid Body Systems", section 4.4).
+// K forces go through together: a chain's passes are one long dependency
+// chain, and K of them interleaved fill the time its latency leaves.
+// Joints are numbered parents first and their columns follow their order,
+// so a force zero from column `extent` on leaves every joint whose column
+// is past it with u = 0 and p = 0 on its child: pass 2 starts below them.
+template <int K>
+void ArticulatedResponse::Passes(const std::array<const Eigen::VectorXd*, K>& forces,
+                                 Eigen::Index extent,
+                                 const std::array<Eigen::VectorXd*, K>& responses, Blocks<K>* bias,
+                                 Blocks<K>* acceleration) {
+  const bool floating = base_dofs_ == 6;
+  Blocks<K>& p = *bias;
+  Blocks<K>& a = *acceleration;
+  for (Block<K>& block : p) block.setZero();
+  std::size_t first_zero = edges_.size();
+  while (first_zero > 0 && edges_[first_zero - 1].column >= extent) --first_zero;
+  std::fill(remainder_.begin() + K * first_zero, remainder_.begin() + K * edges_.size(), 0.0);
+  if (floating) {
+    for (int k = 0; k < K; ++k) {
+      p[0].col(k).template head<3>() = -forces[k]->template segment<3>(3);
+      p[0].col(k).template tail<3>() = -forces[k]->template head<3>();
+    }
+  }
+  for (std::size_t j = first_zero; j-- > 0;) {
+    const Edge& edge = edges_[j];
+    Eigen::Matrix<double, 1, K> u = -subspace_[j].transpose() * p[edge.child];
+    for (int k = 0; k < K; ++k) u[k] += (*forces[k])[edge.column];
+    Eigen::Map<Eigen::Matrix<double, 1, K>> stored(&remainder_[K * j]);
+    stored = u;
+    if (edge.parent == 0 && !floating) continue;
+    p[edge.parent] += p[edge.child] + scaled_[j] * u;
+  }
+  for (int k = 0; k < K; ++k) responses[k]->resize(dof_count_);
+  if (floating) {
+    a[0] = -base_inertia_.solve(p[0]);
+    for (int k = 0; k < K; ++k) {
+      responses[k]->template head<3>() = a[0].col(k).template tail<3>();
+      responses[k]->template segment<3>(3) = a[0].col(k).template head<3>();
+    }
+  } else {
+    a[0].setZero();
+  }
+  for (std::size_t j = 0; j < edges_.size(); ++j) {
+    const Edge& edge = edges_[j];
+    const Eigen::Matrix<double, 1, K> qddot =
+        Eigen::Map<const Eigen::Matrix<double, 1, K>>(&remainder_[K * j]) * inverse_pivot_[j] -
+        scaled_[j].transpose() * a[edge.parent];
+    a[edge.child] = a[edge.parent] + subspace_[j] * qddot;
+    for (int k = 0; k < K; ++k) (*responses[k])[edge.column] = qddot[k];
+  }
+}
+
 void CompositeRigidBodyForwardDynamics(const ForwardDynamicsInput& in,
                                        ArticulationKinematics* kinematics,
                                        Eigen::VectorXd* acceleration) {

@@ -30,24 +30,27 @@ int DrivingDof(const ArticulationModel& model, int joint, double* factor) {
   return model.joints[j.def.mimic_joint].dof;
 }
 
-void PointVelocityRow(const ArticulationModel& model, const ArticulationKinematics& k,
-                      const LinkPoint& at, Eigen::VectorXd* row) {
-  row->setZero(model.DofCount());
+void PointVelocityRows(const ArticulationModel& model, const ArticulationKinematics& k,
+                       const LinkPoint& at, std::array<Eigen::VectorXd, 3>* rows) {
+  for (Eigen::VectorXd& row : *rows) row.setZero(model.DofCount());
   for (int link = at.link; model.links[link].parent_joint >= 0;) {
     const int j = model.links[link].parent_joint;
     const JointDef& def = model.joints[j].def;
     double factor = 1.0;
     const int column = model.base_dofs + DrivingDof(model, j, &factor);
     const Vec3& axis = k.joint_axis_world[j];
-    const double along = def.type == JointType::kPrismatic
-                             ? at.direction.dot(axis)
-                             : at.direction.dot(axis.cross(at.point - k.joint_anchor_world[j]));
-    (*row)[column] += factor * along;
+    const Vec3 moved = def.type == JointType::kPrismatic
+                           ? axis
+                           : Vec3(axis.cross(at.point - k.joint_anchor_world[j]));
+    for (int r = 0; r < 3; ++r) (*rows)[r][column] += factor * at.directions[r].dot(moved);
     link = def.parent_link;
   }
   if (model.base_dofs == 6) {
-    row->head<3>() = at.direction;
-    row->segment<3>(3) = (at.point - k.com_world[0]).cross(at.direction);
+    const Vec3 lever = at.point - k.com_world[0];
+    for (int r = 0; r < 3; ++r) {
+      (*rows)[r].head<3>() = at.directions[r];
+      (*rows)[r].segment<3>(3) = lever.cross(at.directions[r]);
+    }
   }
 }
 

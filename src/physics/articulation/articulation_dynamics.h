@@ -6,9 +6,11 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_DYNAMICS_H_
 #define RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_DYNAMICS_H_
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/StdVector>
 
@@ -88,21 +90,23 @@ bool AnyJointDamped(const ArticulationModel& model);
 // with its leader's dof, times its multiplier.
 int DrivingDof(const ArticulationModel& model, int joint, double* factor);
 
-// A point fixed to a link, and a direction: what a contact row reads.
+// A point fixed to a link, and three directions: what a contact point's
+// normal and friction rows read.
 struct LinkPoint {
   int link = 0;
-  Vec3 point = Vec3::Zero();      // m, world
-  Vec3 direction = Vec3::Zero();  // world
+  Vec3 point = Vec3::Zero();            // m, world
+  std::array<Vec3, 3> directions = {};  // world
 };
 
-// The row r with r . u = d . (velocity of the point): for each joint on the
-// path from the link to the base, d . (s x (p - a)) for a turn about s
-// through a, d . s for a slide (a mimic's on its leader's dof, times its
-// multiplier); for a floating base, d on its centre's velocity and
-// (p - c) x d on its angular velocity. O(depth), from the kinematics'
-// poses; the links' dense Jacobians cost O(n^2) for one row.
-void PointVelocityRow(const ArticulationModel& model, const ArticulationKinematics& kinematics,
-                      const LinkPoint& at, Eigen::VectorXd* row);
+// Per direction d, the row r with r . u = d . (velocity of the point): for
+// each joint on the path from the link to the base, d . (s x (p - a)) for a
+// turn about s through a, d . s for a slide (a mimic's on its leader's dof,
+// times its multiplier); for a floating base, d on its centre's velocity
+// and (p - c) x d on its angular velocity. O(depth) in one walk for the
+// three, from the kinematics' poses; the links' dense Jacobians cost O(n^2)
+// for one row.
+void PointVelocityRows(const ArticulationModel& model, const ArticulationKinematics& kinematics,
+                       const LinkPoint& at, std::array<Eigen::VectorXd, 3>* rows);
 
 // A joint's position and velocity from the state (mimic joints follow their
 // leader).
@@ -197,6 +201,56 @@ void CompositeRigidBodyForwardDynamics(const ForwardDynamicsInput& in,
 // The first where it applies, else the second.
 void ForwardDynamics(const ForwardDynamicsInput& in, ArticulatedBodyScratch* scratch,
                      Eigen::VectorXd* acceleration);
+
+// An articulation's response to generalized impulses, (M + h B)^-1 Q, in
+// O(n) per call from the articulated-body inertias of one evaluation: the
+// row solve's M^-1 J^T for a model too large for a dense factor, whose
+// O(n^3) factor and O(n^2) per row would dominate its step
+// (articulated_body_algorithm.cc). Only where ArticulatedBodyApplies.
+class ArticulatedResponse {
+ public:
+  // Keeps U / D, 1 / D and S of every joint, and the base's articulated
+  // inertia, from `scratch` right after ArticulatedBodyForwardDynamics of
+  // `model` (with h as its damping_step).
+  void Capture(const ArticulationModel& model, const ArticulatedBodyScratch& scratch);
+  // response = (M + h B)^-1 force, force over the model's u and zero from
+  // `extent` on (the joints past it are skipped on the way in).
+  void Apply(const Eigen::VectorXd& force, Eigen::Index extent, Eigen::VectorXd* response);
+  // Three at once, their recursions interleaved: about the time of one.
+  void ApplyThree(const std::array<const Eigen::VectorXd*, 3>& forces, Eigen::Index extent,
+                  const std::array<Eigen::VectorXd*, 3>& responses);
+
+ private:
+  using Vec6 = ArticulatedBodyScratch::Vec6;
+  using Mat6 = ArticulatedBodyScratch::Mat6;
+  template <int K>
+  using Block = Eigen::Matrix<double, 6, K>;
+  template <int K>
+  using Blocks = std::vector<Block<K>, Eigen::aligned_allocator<Block<K>>>;
+  // A joint's links and its column of u, packed for the passes.
+  struct Edge {
+    int parent = 0;
+    int child = 0;
+    int column = 0;
+  };
+  template <int K>
+  void Passes(const std::array<const Eigen::VectorXd*, K>& forces, Eigen::Index extent,
+              const std::array<Eigen::VectorXd*, K>& responses, Blocks<K>* bias,
+              Blocks<K>* acceleration);
+
+  int base_dofs_ = 0;
+  int dof_count_ = 0;
+  std::vector<Edge> edges_;                                     // per joint
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> subspace_;  // per joint, S
+  std::vector<Vec6, Eigen::aligned_allocator<Vec6>> scaled_;    // U / D
+  std::vector<double> inverse_pivot_;                           // 1 / D
+  Eigen::LLT<Mat6> base_inertia_;                               // I^A of a floating base
+  // The passes': per link, the biases p^A and the accelerations; per joint
+  // and force, u.
+  Blocks<1> bias_one_, acceleration_one_;
+  Blocks<3> bias_three_, acceleration_three_;
+  std::vector<double> remainder_;
+};
 
 // The state advanced by h with velocities u: joint positions by h u, the
 // base by h v and a turn of h omega.

@@ -26,6 +26,19 @@ int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u,
   return static_cast<int>(articulations_.size()) - 1;
 }
 
+int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u, ArticulatedResponse* response) {
+  ArticulationSlot& slot = articulations_.emplace_back();
+  slot.u = u;
+  slot.response = response;
+  return static_cast<int>(articulations_.size()) - 1;
+}
+
+int ArticulationSolver::AddArticulationLike(const Eigen::VectorXd& u,
+                                            const ArticulationSlot& like) {
+  articulations_.push_back(ArticulationSlot{u, like.mass, like.response});
+  return static_cast<int>(articulations_.size()) - 1;
+}
+
 int ArticulationSolver::BodySlotOf(const BodySlot& body) {
   if (slot_of_body_.size() <= body.body) slot_of_body_.resize(body.body + 1, -1);
   int& slot = slot_of_body_[body.body];
@@ -36,13 +49,57 @@ int ArticulationSolver::BodySlotOf(const BodySlot& body) {
   return slot;
 }
 
+namespace {
+
+// One past the last nonzero entry.
+Eigen::Index Extent(const Eigen::VectorXd& row) {
+  Eigen::Index end = row.size();
+  while (end > 0 && row[end - 1] == 0.0) --end;
+  return end;
+}
+
+}  // namespace
+
+// With the dense factor, a row keeps its full extent, so that its dots sum
+// in the order they always did (bit for bit); with the articulated-body
+// passes, its zeros past its path are skipped.
 RowSide ArticulationSolver::ArticulationSide(int slot, const Eigen::VectorXd& jacobian) const {
   RowSide side;
   side.kind = RowSide::Kind::kArticulation;
   side.slot = slot;
   side.jacobian = jacobian;
-  side.response = articulations_[slot].mass.solve(jacobian);
+  const ArticulationSlot& articulation = articulations_[slot];
+  if (articulation.response != nullptr) {
+    side.extent = Extent(jacobian);
+    articulation.response->Apply(jacobian, side.extent, &side.response);
+  } else {
+    side.extent = jacobian.size();
+    side.response = articulation.mass.solve(jacobian);
+  }
   return side;
+}
+
+std::array<RowSide, 3> ArticulationSolver::ArticulationSides(
+    int slot, std::array<Eigen::VectorXd, 3> jacobians) const {
+  const ArticulationSlot& articulation = articulations_[slot];
+  std::array<RowSide, 3> sides;
+  if (articulation.response == nullptr) {
+    for (int r = 0; r < 3; ++r) sides[r] = ArticulationSide(slot, jacobians[r]);
+    return sides;
+  }
+  std::array<Eigen::VectorXd*, 3> responses;
+  Eigen::Index extent = 0;
+  for (int r = 0; r < 3; ++r) {
+    sides[r].kind = RowSide::Kind::kArticulation;
+    sides[r].slot = slot;
+    sides[r].jacobian = std::move(jacobians[r]);
+    sides[r].extent = Extent(sides[r].jacobian);
+    extent = std::max(extent, sides[r].extent);
+    responses[r] = &sides[r].response;
+  }
+  articulation.response->ApplyThree({&sides[0].jacobian, &sides[1].jacobian, &sides[2].jacobian},
+                                    extent, responses);
+  return sides;
 }
 
 RowSide ArticulationSolver::BodySide(int slot, const Vec3& direction, const Vec3& lever_arm) const {
@@ -66,7 +123,7 @@ int ArticulationSolver::AddRow(ConstraintRow row) {
 double ArticulationSolver::SideVelocity(const RowSide& side) const {
   switch (side.kind) {
     case RowSide::Kind::kArticulation:
-      return side.jacobian.dot(articulations_[side.slot].u);
+      return side.jacobian.head(side.extent).dot(articulations_[side.slot].u.head(side.extent));
     case RowSide::Kind::kBody: {
       const BodySlot& body = bodies_[side.slot];
       return side.linear.dot(body.linear_velocity) + side.angular.dot(body.angular_velocity);
@@ -80,7 +137,7 @@ double ArticulationSolver::SideVelocity(const RowSide& side) const {
 double ArticulationSolver::SideResponse(const RowSide& side) const {
   switch (side.kind) {
     case RowSide::Kind::kArticulation:
-      return side.jacobian.dot(side.response);
+      return side.jacobian.head(side.extent).dot(side.response.head(side.extent));
     case RowSide::Kind::kBody:
       return side.linear.dot(side.linear_response) + side.angular.dot(side.angular_response);
     case RowSide::Kind::kNone:

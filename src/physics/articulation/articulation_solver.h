@@ -17,6 +17,7 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SOLVER_H_
 #define RIGID_BODY_SIM_PHYSICS_ARTICULATION_ARTICULATION_SOLVER_H_
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -24,6 +25,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "physics/articulation/articulation_dynamics.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::physics {
@@ -33,9 +35,12 @@ namespace rigid_body_sim::physics {
 struct RowSide {
   enum class Kind : std::uint8_t { kNone, kArticulation, kBody };
   Kind kind = Kind::kNone;
-  int slot = -1;                         // index of the articulation or body slot
-  Eigen::VectorXd jacobian;              // articulation: J_k over its u
-  Eigen::VectorXd response;              // articulation: M^-1 J_k^T
+  int slot = -1;             // index of the articulation or body slot
+  Eigen::VectorXd jacobian;  // articulation: J_k over its u
+  Eigen::VectorXd response;  // articulation: M^-1 J_k^T
+  // articulation: J_k's entries from here on are zero (a link's row reaches
+  // only the columns of the joints on its path, all before its own).
+  Eigen::Index extent = 0;
   Vec3 linear = Vec3::Zero();            // body: d
   Vec3 angular = Vec3::Zero();           // body: r x d
   Vec3 linear_response = Vec3::Zero();   // body: d / m
@@ -85,18 +90,30 @@ class ArticulationSolver {
     double inverse_mass = 0.0;
     Mat3 inverse_inertia_world = Mat3::Zero();
   };
+  // An articulation's u and how M^-1 is applied to its rows: the factor of
+  // its joint-space inertia, or, where `response` is set, the articulated-
+  // body passes (ArticulatedResponse), which must outlive the solve.
   struct ArticulationSlot {
     Eigen::VectorXd u;
-    Eigen::LLT<Eigen::MatrixXd> mass;  // factor of the joint-space inertia
+    Eigen::LLT<Eigen::MatrixXd> mass;
+    ArticulatedResponse* response = nullptr;
   };
 
   void Reset();
   int AddArticulation(const Eigen::VectorXd& u, const Eigen::MatrixXd& mass);
   // As above, with the joint-space inertia already factored.
   int AddArticulation(const Eigen::VectorXd& u, const Eigen::LLT<Eigen::MatrixXd>& mass);
+  // With its rows' responses from the articulated-body passes, O(n) each.
+  int AddArticulation(const Eigen::VectorXd& u, ArticulatedResponse* response);
+  // With the inertia of another solver's `slot` and velocities `u`.
+  int AddArticulationLike(const Eigen::VectorXd& u, const ArticulationSlot& slot);
   // The slot of a rigid body, added once.
   int BodySlotOf(const BodySlot& body);
   RowSide ArticulationSide(int slot, const Eigen::VectorXd& jacobian) const;
+  // Three sides at once (a contact point's normal and tangent rows): with
+  // the articulated-body passes, their responses in one fused pass.
+  std::array<RowSide, 3> ArticulationSides(int slot,
+                                           std::array<Eigen::VectorXd, 3> jacobians) const;
   RowSide BodySide(int slot, const Vec3& direction, const Vec3& lever_arm) const;
   int AddRow(ConstraintRow row);
 

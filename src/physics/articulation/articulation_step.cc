@@ -25,6 +25,10 @@ namespace {
 
 // rad or m: how near its limit a joint keeps its limit row.
 constexpr double kLimitTolerance = 1e-6;
+// Above this many dofs an articulation's rows take M^-1 J^T from the
+// articulated-body passes, O(n) each, instead of the dense factor, O(n^3)
+// once and O(n^2) per row (bench figures in docs/performance.md).
+constexpr int kMostDenseResponseDofs = 24;
 // The solver's state is refused beyond this size, as the step guard refuses
 // a body's (a step's products could overflow).
 constexpr double kMaxMagnitude = 1e100;
@@ -279,13 +283,21 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
     entry.next_kinematics_current = true;
     return -1;
   }
-  Eigen::MatrixXd mass;
-  JointSpaceInertia(model, k, &mass);
-  for (const ArticulationJoint& joint : model.joints) {
-    if (joint.dof >= 0)
-      mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) += step.dt * joint.def.damping;
+  int slot = -1;
+  if (model.DofCount() > kMostDenseResponseDofs && ArticulatedBodyApplies(model)) {
+    // scratch_ holds the articulated-body evaluation of u' just made.
+    entry.response.Capture(model, scratch_);
+    slot = solver_.AddArticulation(u_free, &entry.response);
+  } else {
+    Eigen::MatrixXd mass;
+    JointSpaceInertia(model, k, &mass);
+    for (const ArticulationJoint& joint : model.joints) {
+      if (joint.dof >= 0)
+        mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) +=
+            step.dt * joint.def.damping;
+    }
+    slot = solver_.AddArticulation(u_free, mass);
   }
-  const int slot = solver_.AddArticulation(u_free, mass);
   AddArticulationRows(index, slot, joint_rows);
   return slot;
 }

@@ -78,6 +78,8 @@ struct ArticulationEntry {
   bool next_kinematics_current = false;
   ServoGains gains;
   FreeMotionIntegrator free_motion;
+  // Its rows' M^-1 J^T in a step of a large model (SetUpArticulation).
+  ArticulatedResponse response;
   // The impulse each joint row ended its last step with, per joint and
   // JointRowRole (0 for a row it did not have): the next step's warm start.
   std::vector<double> joint_row_impulses;
@@ -139,8 +141,10 @@ class ArticulationSystem {
   void AddLinkContactRows(const StepContext& step, const std::vector<int>& slot_of_articulation);
   int AddLinkPointRows(const StepContext& step, const std::vector<int>& slot_of_articulation,
                        const ShapePairContact& pair, int i);
-  RowSide LinkContactSide(const std::vector<int>& slot_of_articulation, std::uint32_t index,
-                          const Vec3& direction, const Vec3& point);
+  // A body's sides of a point's three rows, along `directions`.
+  std::array<RowSide, 3> LinkContactSides(const std::vector<int>& slot_of_articulation,
+                                          std::uint32_t index,
+                                          const std::array<Vec3, 3>& directions, const Vec3& point);
   double StartPointVelocity(std::uint32_t index, const Vec3& direction, const Vec3& point) const;
   void BounceLinkContacts(const StepContext& step, const std::vector<int>& slot_of_articulation);
   std::vector<double> LinkImpactTimes(const StepContext& step,

@@ -27,18 +27,20 @@ double ArticulationSystem::StartPointVelocity(std::uint32_t index, const Vec3& d
   return direction.dot(body.start_linear_velocity + angular.cross(r));
 }
 
-// One side of a link-contact row along `direction` at `point`: a link's
-// through the joints on its path to the base (PointVelocityRow), a rigid
-// body's through its mass and inertia (a static or resting one has none).
-RowSide ArticulationSystem::LinkContactSide(const std::vector<int>& slot_of_articulation,
-                                            std::uint32_t index, const Vec3& direction,
-                                            const Vec3& point) {
+// A body's sides of the three rows of a contact point, along `directions`:
+// a link's through the joints on its path to the base (PointVelocityRows),
+// their responses made together (ArticulationSolver::ArticulationSides); a
+// rigid body's through its mass and inertia (a static or resting one has
+// none).
+std::array<RowSide, 3> ArticulationSystem::LinkContactSides(
+    const std::vector<int>& slot_of_articulation, std::uint32_t index,
+    const std::array<Vec3, 3>& directions, const Vec3& point) {
   const Body& body = bodies_[index];
   if (body.articulation >= 0) {
     const ArticulationEntry& entry = articulations_[body.articulation];
-    Eigen::VectorXd row;
-    PointVelocityRow(entry.model, entry.kinematics, {body.link, point, direction}, &row);
-    return solver_.ArticulationSide(slot_of_articulation[body.articulation], row);
+    std::array<Eigen::VectorXd, 3> rows;
+    PointVelocityRows(entry.model, entry.kinematics, {body.link, point, directions}, &rows);
+    return solver_.ArticulationSides(slot_of_articulation[body.articulation], std::move(rows));
   }
   ArticulationSolver::BodySlot body_slot;
   body_slot.body = index;
@@ -49,7 +51,11 @@ RowSide ArticulationSystem::LinkContactSide(const std::vector<int>& slot_of_arti
     body_slot.inverse_mass = body.inverse_mass;
     body_slot.inverse_inertia_world = body.inverse_inertia_world;
   }
-  return solver_.BodySide(solver_.BodySlotOf(body_slot), direction, point - body.position);
+  const int slot = solver_.BodySlotOf(body_slot);
+  std::array<RowSide, 3> sides;
+  for (int r = 0; r < 3; ++r)
+    sides[r] = solver_.BodySide(slot, directions[r], point - body.position);
+  return sides;
 }
 
 // Per point of a pair with a link: a normal row and two friction rows. The
@@ -91,11 +97,16 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
   const Vec3 normal = pair.manifold.normal_world;
   const std::array<Vec3, 2> tangent = TangentBasis(normal);
   const ContactPoint& point = pair.manifold.points[i];
+  // Side a's rows along the normal and the tangents, side b's against them.
+  std::array<RowSide, 3> sides_a = LinkContactSides(
+      slot_of_articulation, pair.body_a, {normal, tangent[0], tangent[1]}, point.position_world);
+  std::array<RowSide, 3> sides_b = LinkContactSides(
+      slot_of_articulation, pair.body_b, {-normal, -tangent[0], -tangent[1]}, point.position_world);
   ConstraintRow normal_row;
   normal_row.kind = RowKind::kNormal;
   normal_row.restitution = restitution;
-  normal_row.a = LinkContactSide(slot_of_articulation, pair.body_a, normal, point.position_world);
-  normal_row.b = LinkContactSide(slot_of_articulation, pair.body_b, -normal, point.position_world);
+  normal_row.a = std::move(sides_a[0]);
+  normal_row.b = std::move(sides_b[0]);
   const double approach = StartPointVelocity(pair.body_a, normal, point.position_world) +
                           StartPointVelocity(pair.body_b, -normal, point.position_world);
   const double separation = point.separation;
@@ -119,10 +130,8 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
   for (int t = 0; t < 2; ++t) {
     ConstraintRow tangent_row;
     tangent_row.kind = RowKind::kTangent;
-    tangent_row.a =
-        LinkContactSide(slot_of_articulation, pair.body_a, tangent[t], point.position_world);
-    tangent_row.b =
-        LinkContactSide(slot_of_articulation, pair.body_b, -tangent[t], point.position_world);
+    tangent_row.a = std::move(sides_a[1 + t]);
+    tangent_row.b = std::move(sides_b[1 + t]);
     tangent_row.normal_row = normal_index;
     tangent_row.friction = friction;
     tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
@@ -264,7 +273,7 @@ void ArticulationSystem::CorrectLinkPenetration(const StepContext& step,
       int& slot = pseudo_slot[side.slot];
       if (slot < 0) {
         const ArticulationSolver::ArticulationSlot& from = velocity_slots[side.slot];
-        slot = pseudo.AddArticulation(Eigen::VectorXd::Zero(from.u.size()), from.mass);
+        slot = pseudo.AddArticulationLike(Eigen::VectorXd::Zero(from.u.size()), from);
       }
       side.slot = slot;
     } else if (side.kind == RowSide::Kind::kBody) {
