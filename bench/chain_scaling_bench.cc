@@ -5,9 +5,10 @@
 // per joint at dt = 1/240 s; one thread.
 //
 // With --uniform, every rod weighs the same (no whip): the plain hanging
-// chain.
+// chain. With --damped, every joint has 0.01 N m s/rad of damping, as many
+// URDFs give.
 //
-// Usage: chain_scaling_bench [--uniform] [STEPS [JOINTS...]]
+// Usage: chain_scaling_bench [--uniform] [--damped] [STEPS [JOINTS...]]
 //        (default 480; 30 50 64 100)
 #include <algorithm>
 #include <chrono>
@@ -41,7 +42,7 @@ LinkDef Rod(double mass) {
   return link;
 }
 
-ArticulationDef Chain(int joints, double tip_ratio) {
+ArticulationDef Chain(int joints, double tip_ratio, double damping) {
   ArticulationDef def;
   def.fixed_base = true;
   def.world_from_base.translation = Vec3(0, 0, 100);
@@ -59,6 +60,7 @@ ArticulationDef Chain(int joints, double tip_ratio) {
     joint.parent_from_joint.translation = Vec3(0, 0, i == 1 ? 0.0 : -kRodLength);
     joint.axis = Vec3::UnitY();
     joint.position = 0.3;
+    joint.damping = damping;
     def.joints.push_back(joint);
   }
   return def;
@@ -68,19 +70,25 @@ ArticulationDef Chain(int joints, double tip_ratio) {
 
 int main(int argc, char** argv) {
   int first = 1;
-  const bool uniform = argc > 1 && std::string(argv[1]) == "--uniform";
-  if (uniform) ++first;
+  bool uniform = false;
+  bool damped = false;
+  for (; first < argc && argv[first][0] == '-'; ++first) {
+    const std::string flag = argv[first];
+    uniform = uniform || flag == "--uniform";
+    damped = damped || flag == "--damped";
+  }
   const int steps = argc > first ? std::atoi(argv[first]) : 480;
   std::vector<int> sizes;
   for (int i = first + 1; i < argc; ++i) sizes.push_back(std::atoi(argv[i]));
   if (sizes.empty()) sizes = {30, 50, 64, 100};
-  std::printf("movable joints, mean ms/step, worst ms/step (%d steps, %s, dt 1/240 s)\n", steps,
-              uniform ? "uniform rods" : "heavy tip");
+  std::printf("movable joints, mean ms/step, worst ms/step (%d steps, %s%s, dt 1/240 s)\n", steps,
+              uniform ? "uniform rods" : "heavy tip", damped ? ", damped" : "");
   for (const int joints : sizes) {
     WorldSettings settings;
     settings.time_step = 1.0 / 240.0;
     World world(settings);
-    if (!world.CreateArticulation(Chain(joints, uniform ? 1.0 : 1000.0)).ok()) {
+    if (!world.CreateArticulation(Chain(joints, uniform ? 1.0 : 1000.0, damped ? 0.01 : 0.0))
+             .ok()) {
       std::printf("%d: refused\n", joints);
       continue;
     }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "physics/articulation/articulation_dynamics.h"
 
@@ -240,6 +241,57 @@ TEST(JointSpaceInertiaTest, ArticulatedResponseMatchesTheDenseFactor) {
     }
   }
   EXPECT_EQ(compared, 144);
+}
+
+// The damping's fastest decay rate by the power method against the largest
+// generalized eigenvalue of B x = lambda M x from a dense solver: never
+// above it (its Rayleigh quotients rise from below), and within 1e-6 of it
+// after 30 calls of 4 iterations each, on random trees with half their
+// joints damped, fixed and floating, from the response to M and to M + h B.
+TEST(JointSpaceInertiaTest, FastestDampingRateRisesToTheGeneralizedEigenvalue) {
+  std::mt19937 random(20261204);
+  int compared = 0;
+  for (const bool floating : {false, true}) {
+    for (const int links : {3, 12, 40}) {
+      for (const double h : {0.0, 1.0 / 240.0}) {
+        ArticulationModel model = RandomTree(links, floating, &random, /*mimics=*/false);
+        for (std::size_t j = 0; j < model.joints.size(); ++j) {
+          model.joints[j].def.damping =
+              j % 2 == 0 ? std::uniform_real_distribution<double>(0.1, 2.0)(random) : 0.0;
+        }
+        const ArticulationState state = RandomState(model, Vec3(1.0, 2.0, 0.5), &random);
+        ArticulationKinematics kinematics;
+        ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
+        ArticulatedBodyScratch scratch;
+        Eigen::VectorXd acceleration;
+        ArticulatedBodyForwardDynamics({model, state, kinematics, Vec3(0, 0, -9.81),
+                                        Eigen::VectorXd::Zero(model.joint_dofs), h},
+                                       &scratch, &acceleration);
+        ArticulatedResponse response;
+        response.Capture(model, scratch);
+        Eigen::MatrixXd mass;
+        JointSpaceInertia(model, kinematics, &mass);
+        Eigen::MatrixXd damping = Eigen::MatrixXd::Zero(mass.rows(), mass.cols());
+        for (const ArticulationJoint& joint : model.joints) {
+          damping(model.base_dofs + joint.dof, model.base_dofs + joint.dof) = joint.def.damping;
+        }
+        const double exact =
+            Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(damping, mass)
+                .eigenvalues()
+                .maxCoeff();
+        ASSERT_GT(exact, 0.0);
+        DampingModeScratch modes;
+        double rate = 0.0;
+        for (int call = 0; call < 30; ++call) {
+          rate = FastestDampingRate(model, h, &response, &modes);
+          EXPECT_LE(rate, exact * (1.0 + 1e-9)) << links << " links, call " << call;
+        }
+        EXPECT_NEAR(rate / exact, 1.0, 1e-6) << links << " links, floating " << floating;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 12);
 }
 
 // A contact point's three rows from the joints on the link's path to the

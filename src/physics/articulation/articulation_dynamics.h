@@ -252,6 +252,20 @@ class ArticulatedResponse {
   std::vector<double> remainder_;
 };
 
+// FastestDampingRate's vectors: B^1/2's diagonal, the power method's
+// iterate, kept from call to call, and its image.
+struct DampingModeScratch {
+  Eigen::VectorXd root_damping;
+  Eigen::VectorXd mode;
+  Eigen::VectorXd image;
+};
+
+// lambda_max(M^-1 B), the fastest decay rate of the joints' damping B, from
+// below, by the power method from scratch->mode (articulated_body_
+// algorithm.cc). `response` is the articulation's response to M + h B.
+double FastestDampingRate(const ArticulationModel& model, double h, ArticulatedResponse* response,
+                          DampingModeScratch* scratch);
+
 // The state advanced by h with velocities u: joint positions by h u, the
 // base by h v and a turn of h omega.
 ArticulationState Advance(const ArticulationModel& model, const ArticulationState& state,

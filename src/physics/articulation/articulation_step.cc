@@ -14,6 +14,7 @@
 // bounce.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "physics/articulation/articulation_system.h"
@@ -94,6 +95,15 @@ bool DampingIsStiff(const ArticulationModel& model, const ArticulationKinematics
     rate += joint.def.damping * inverse(column, column);
   }
   return dt * rate > kMaxRate;
+}
+
+// The same test for a model too large for the dense inverse (O(n^3) each
+// step: 0.2 s at 999 joints), with lambda_max itself (FastestDampingRate)
+// instead of the trace's bound.
+bool LargeDampingIsStiff(const ArticulationModel& model, ArticulatedResponse* response, double dt,
+                         DampingModeScratch* scratch) {
+  constexpr double kMaxRate = 0.5;  // dt lambda, as DampingIsStiff's
+  return dt * FastestDampingRate(model, dt, response, scratch) > kMaxRate;
 }
 
 // Per movable joint: its limits when the free step would reach them, its
@@ -273,10 +283,16 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
   for (ArticulationJoint& joint : model.joints) {
     joint.effort = joint.dof >= 0 ? efforts[joint.dof] : 0.0;
   }
-  if (joint_rows.empty() && !touched && !DampingIsStiff(model, k, step.dt)) {
+  const bool damped = AnyJointDamped(model);
+  const bool large = model.DofCount() > kMostDenseResponseDofs && ArticulatedBodyApplies(model);
+  // scratch_ holds the articulated-body evaluation of u' just made.
+  if (large && (damped || touched || !joint_rows.empty())) entry.response.Capture(model, scratch_);
+  const bool stiff =
+      damped && (large ? LargeDampingIsStiff(model, &entry.response, step.dt, &entry.damping_modes)
+                       : DampingIsStiff(model, k, step.dt));
+  if (joint_rows.empty() && !touched && !stiff) {
     // Without damping, u* came from the explicit dynamics: the first
     // RK4 stage's u'.
-    const bool damped = AnyJointDamped(model);
     entry.free_motion.Step({model, entry.state, k, step.settings->gravity, efforts, step.dt,
                             damped ? nullptr : &acceleration},
                            {&entry.next, &entry.next_kinematics});
@@ -284,9 +300,7 @@ int ArticulationSystem::SetUpArticulation(const StepContext& step, std::uint32_t
     return -1;
   }
   int slot = -1;
-  if (model.DofCount() > kMostDenseResponseDofs && ArticulatedBodyApplies(model)) {
-    // scratch_ holds the articulated-body evaluation of u' just made.
-    entry.response.Capture(model, scratch_);
+  if (large) {
     slot = solver_.AddArticulation(u_free, &entry.response);
   } else {
     Eigen::MatrixXd mass;

@@ -78,8 +78,10 @@ struct ArticulationEntry {
   bool next_kinematics_current = false;
   ServoGains gains;
   FreeMotionIntegrator free_motion;
-  // Its rows' M^-1 J^T in a step of a large model (SetUpArticulation).
+  // Its rows' M^-1 J^T in a step of a large model (SetUpArticulation), and
+  // the power method's vectors for its damping's fastest mode.
   ArticulatedResponse response;
+  DampingModeScratch damping_modes;
   // The impulse each joint row ended its last step with, per joint and
   // JointRowRole (0 for a row it did not have): the next step's warm start.
   std::vector<double> joint_row_impulses;
