@@ -123,9 +123,12 @@ std::string HingeChain(int joints) {
 // world lock, so their count has a limit of its own
 // (kDefaultMaxJointsPerModel by default), met before anything is built; a
 // model whose joints are welded has none to move and is not held to it.
+// The default admits every chain the default link limit does, so the links
+// are let go beyond it here for the joints' limit to be the one met.
 TEST(UrdfHostileTest, MovableJointsBeyondTheLimitAreRefusedByName) {
   UrdfLoadOptions options;
   options.articulate = true;
+  options.max_links = 2 * kDefaultMaxJointsPerModel;
   const int limit = kDefaultMaxJointsPerModel;
   const std::string count = std::to_string(limit + 1) + " movable joints";
   const std::string named = "max_joints_per_model " + std::to_string(limit);
@@ -133,6 +136,10 @@ TEST(UrdfHostileTest, MovableJointsBeyondTheLimitAreRefusedByName) {
   const Result<LoadedModel> at_limit = LoadUrdfString(HingeChain(limit), options);
   ASSERT_TRUE(at_limit.ok()) << at_limit.message();
   EXPECT_EQ(at_limit->joints.size(), static_cast<std::size_t>(limit));
+  // The largest chain the default link limit admits loads by default.
+  UrdfLoadOptions defaults;
+  defaults.articulate = true;
+  EXPECT_TRUE(LoadUrdfString(HingeChain(defaults.max_links - 1), defaults).ok());
   options.max_joints = 65;
   EXPECT_TRUE(LoadUrdfString(HingeChain(65), options).ok());
   options.max_joints = 64;
@@ -372,7 +379,7 @@ TEST(UrdfHostileTest, MimicEffortScaleMustStayFinite) {
               "'/><axis xyz='0 1 0'/><limit lower='-1' upper='1' effort='1' velocity='1'/>"
               "<mimic joint='finger_1' multiplier='1000'/></joint>";
   }
-  // 202 movable joints, above the default ~max_joints_per_model: the
+  // 202 movable joints, within the largest ~max_joints_per_model: the
   // effort scale is what this test is about.
   UrdfLoadOptions options = Articulated();
   options.max_joints = 999;

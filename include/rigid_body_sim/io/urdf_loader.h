@@ -25,12 +25,13 @@
 namespace rigid_body_sim::io {
 
 // Movable joints of one articulated model by default (~max_joints_per_model):
-// a free step costs about n (the articulated-body algorithm), a constrained
-// one n^3 (its joint-space inertia factored); a 250-joint chain's worst free
-// step (a swinging heavy tip, split by the energy balance) takes 21 ms and a
-// 250-joint rope lying on the ground 20 ms on the reference machine
-// (docs/limits.md), so no call waits 100 ms behind one step.
-inline constexpr int kDefaultMaxJointsPerModel = 250;
+// a free step costs about n (the articulated-body algorithm, its parts
+// capped by a budget), a constrained one about n per contact point; the
+// largest chain ~max_links_per_model admits (999 joints) steps free in
+// 6 ms at worst, and a 999-joint rope lying on the ground in 60 ms
+// (130 ms in the steps where it lands) on the reference machine
+// (docs/limits.md).
+inline constexpr int kDefaultMaxJointsPerModel = 999;
 
 // Limits on collision geometry: every size of a box, cylinder, sphere or
 // mesh hull (m), and a shape's largest size over its smallest. Outside them

@@ -83,7 +83,7 @@ struct NodeOptions {
   // every sensor's noise, so a run repeats its readings.
   int sensor_noise_seed = 0;
   // ~max_joints_per_model: count, [1, 999]: movable joints of one
-  // articulated model (io::kDefaultMaxJointsPerModel, 250).
+  // articulated model (io::kDefaultMaxJointsPerModel, 999).
   int max_joints_per_model = io::kDefaultMaxJointsPerModel;
   // The position servo of joint commands (physics/articulation.h):
   // ~joint_stiffness (N m/rad or N/m, 1e5, (0, 1e12]) and ~joint_damping
