@@ -122,6 +122,10 @@ std::string FrameName(const std::string& model, const std::string& link) {
 }
 
 int LinkIndex(const Model& model, const std::string& link_name) {
+  if (!model.link_index.empty()) {
+    const auto found = model.link_index.find(link_name);
+    return found == model.link_index.end() ? -1 : found->second;
+  }
   for (std::size_t i = 0; i < model.links.size(); ++i) {
     if (model.links[i].link_name == link_name) return static_cast<int>(i);
   }
@@ -186,6 +190,10 @@ Status ModelRegistry::Add(Model model) {
   }
   if (model.bodies.empty()) model.bodies = {model.body};
   for (const physics::BodyId body : model.bodies) name_by_body_[Key(body)] = model.name;
+  model.link_index.clear();
+  for (std::size_t i = 0; i < model.links.size(); ++i) {
+    model.link_index.emplace(model.links[i].link_name, static_cast<int>(i));
+  }
   std::string name = model.name;
   models_.emplace(std::move(name), std::move(model));
   return Status::Ok();

@@ -241,6 +241,38 @@ TEST(BruteForcePairsTest, AppliesTheSameRules) {
   EXPECT_EQ(BruteForcePairs(proxies), expected);
 }
 
+// Proxies of one collision group never pair, whatever their kinds; group 0
+// is none, and pairs as before.
+TEST(SortAndSweepBroadPhaseTest, OneCollisionGroupNeverPairs) {
+  SortAndSweepBroadPhase broad_phase;
+  const int a = broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0)), ProxyKind::kDynamic, 3).value();
+  const int b = broad_phase.AddProxy(UnitCubeAt(Vec3(0.5, 0, 0)), ProxyKind::kDynamic, 3).value();
+  const int c = broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0.5, 0)), ProxyKind::kDynamic, 4).value();
+  const int d = broad_phase.AddProxy(UnitCubeAt(Vec3(0, 0, 0.5)), ProxyKind::kSleeping, 3).value();
+  const int e = broad_phase.AddProxy(UnitCubeAt(Vec3(0.5, 0.5, 0)), ProxyKind::kDynamic).value();
+  broad_phase.Update();
+  EXPECT_FALSE(broad_phase.HasPair(a, b));
+  EXPECT_FALSE(broad_phase.HasPair(a, d));
+  EXPECT_TRUE(broad_phase.HasPair(a, c));
+  EXPECT_TRUE(broad_phase.HasPair(b, e));
+  EXPECT_TRUE(broad_phase.HasPair(c, d));
+  // Waking d keeps it out of its group's pairs (SetKind's own path).
+  ASSERT_TRUE(broad_phase.SetKind(d, ProxyKind::kDynamic).ok());
+  broad_phase.Update();
+  EXPECT_FALSE(broad_phase.HasPair(a, d));
+  EXPECT_FALSE(broad_phase.HasPair(b, d));
+  // Moving b across a (the insertion sort's path) pairs them no more.
+  ASSERT_TRUE(broad_phase.SetAabb(b, UnitCubeAt(Vec3(-0.5, 0, 0))).ok());
+  broad_phase.Update();
+  EXPECT_FALSE(broad_phase.HasPair(a, b));
+  const std::vector<ProxyState> states = {{a, broad_phase.GetAabb(a), ProxyKind::kDynamic, 3},
+                                          {b, broad_phase.GetAabb(b), ProxyKind::kDynamic, 3},
+                                          {c, broad_phase.GetAabb(c), ProxyKind::kDynamic, 4},
+                                          {d, broad_phase.GetAabb(d), ProxyKind::kDynamic, 3},
+                                          {e, broad_phase.GetAabb(e), ProxyKind::kDynamic, 0}};
+  EXPECT_EQ(BruteForcePairs(states), broad_phase.Pairs());
+}
+
 // A random world of boxes: moving, bouncing inside a region, teleporting,
 // added, removed, static, falling asleep and waking up. Half of the boxes
 // live on a 1/16 m grid so that equal endpoint values (touching faces) are
@@ -263,6 +295,8 @@ class RandomBoxWorld {
     const double kind_draw = Uniform(0, 1);
     box.kind = kind_draw < 0.1 ? ProxyKind::kStatic
                                : (kind_draw < 0.2 ? ProxyKind::kSleeping : ProxyKind::kDynamic);
+    // A third in one of four collision groups (an articulation's links).
+    box.group = Uniform(0, 1) < 0.33 ? 1 + static_cast<std::uint32_t>(Uniform(0, 4)) : 0;
     const bool fast = Uniform(0, 1) < 0.05;
     const double speed = fast ? 30.0 : 2.0;  // m/s
     for (int axis = 0; axis < 3; ++axis) {
@@ -276,9 +310,9 @@ class RandomBoxWorld {
       if (boxes_.count(id) != 0) {
         id = next_chosen_id_++;
       }
-      ASSERT_TRUE(broad_phase.AddProxyWithId(id, BoxAabb(box), box.kind).ok());
+      ASSERT_TRUE(broad_phase.AddProxyWithId(id, BoxAabb(box), box.kind, box.group).ok());
     } else {
-      const Result<int> added = broad_phase.AddProxy(BoxAabb(box), box.kind);
+      const Result<int> added = broad_phase.AddProxy(BoxAabb(box), box.kind, box.group);
       ASSERT_TRUE(added.ok());
       id = added.value();
     }
@@ -343,7 +377,7 @@ class RandomBoxWorld {
     std::vector<ProxyState> states;
     states.reserve(boxes_.size());
     for (const auto& [id, box] : boxes_) {
-      states.push_back(ProxyState{id, BoxAabb(box), box.kind});
+      states.push_back(ProxyState{id, BoxAabb(box), box.kind, box.group});
     }
     return states;
   }
@@ -356,6 +390,7 @@ class RandomBoxWorld {
     Vec3 size = Vec3::Ones();      // m
     Vec3 velocity = Vec3::Zero();  // m/s
     ProxyKind kind = ProxyKind::kDynamic;
+    std::uint32_t group = 0;
     bool on_grid = false;
   };
 

@@ -22,7 +22,7 @@ std::vector<ProxyPair> BruteForcePairs(const std::vector<ProxyState>& proxies) {
         overlap &= (a.aabb_world.min[axis] <= b.aabb_world.max[axis]) &
                    (b.aabb_world.min[axis] <= a.aabb_world.max[axis]);
       }
-      if (overlap && PairIsReported(a.kind, b.kind)) {
+      if (overlap && PairIsReported(a.kind, b.kind, a.group, b.group)) {
         pairs.push_back(ProxyPair{std::min(a.id, b.id), std::max(a.id, b.id)});
       }
     }

@@ -128,12 +128,16 @@ struct Model {
   // The URDF's root is a `world` link: robot_state_publisher publishes its
   // world -> root itself, so TfMode::kRoot adds nothing.
   bool world_link = false;
+  // Link names to their index in `links`, made by ModelRegistry::Add, so
+  // that tf's per-joint lookups stay O(1) on a 1000-link model.
+  std::unordered_map<std::string, int> link_index;
 };
 
 // The tf frame of a link of `model`: its tf prefix and the link's name.
 std::string TfFrame(const Model& model, const std::string& link);
 
-// The index of the link named `link_name` in model.links, or -1.
+// The index of the link named `link_name` in model.links, or -1 (from its
+// link_index once the model is registered, by a scan before).
 int LinkIndex(const Model& model, const std::string& link_name);
 
 // A frame of a model: the model and one of its links.

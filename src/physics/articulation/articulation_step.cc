@@ -180,6 +180,11 @@ bool ArticulationSystem::SkipsPair(const Body& a, const Body& b) const {
   return joined(a.link, b.link) || joined(b.link, a.link);
 }
 
+std::uint32_t ArticulationSystem::CollisionGroup(const Body& body) const {
+  if (body.articulation < 0 || articulations_[body.articulation].model.self_collide) return 0;
+  return static_cast<std::uint32_t>(body.articulation) + 1;
+}
+
 void ArticulationSystem::TakeLinkPairs(const std::vector<ShapePairContact*>& touching,
                                        std::vector<ShapePairContact*>* rigid_pairs) {
   rigid_pairs->clear();

@@ -111,6 +111,9 @@ class ArticulationSystem {
                       const Vec3& angular_velocity, int link);
   // Two links of one articulation that are not to collide.
   bool SkipsPair(const Body& a, const Body& b) const;
+  // A body's collision group in the broad phase: its articulation's index
+  // + 1 for a link of one that does not collide with itself, else 0 (none).
+  std::uint32_t CollisionGroup(const Body& body) const;
 
   // The step (articulation_step.cc, link_contacts.cc). Stage 4: the touching pairs split into
   // the rigid bodies' (`rigid_pairs`, the contact solver's) and those with a

@@ -49,7 +49,8 @@ ProxyKind SortAndSweepBroadPhase::GetKind(int id) const {
   return proxies_[id].kind;
 }
 
-Result<int> SortAndSweepBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind kind) {
+Result<int> SortAndSweepBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind kind,
+                                             std::uint32_t group) {
   // Ids chosen by the caller may have taken entries of the free list since
   // they were pushed; drop those lazily.
   while (!free_ids_.empty() && proxies_[free_ids_.back()].in_use) {
@@ -61,14 +62,15 @@ Result<int> SortAndSweepBroadPhase::AddProxy(const Aabb& aabb_world, ProxyKind k
     return Result<int>::Error("broad phase: no free proxy id below " +
                               std::to_string(kMaxProxyId + 1));
   }
-  const Status status = AddProxyWithId(static_cast<int>(id), aabb_world, kind);
+  const Status status = AddProxyWithId(static_cast<int>(id), aabb_world, kind, group);
   if (!status.ok()) {
     return status;
   }
   return static_cast<int>(id);
 }
 
-Status SortAndSweepBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, ProxyKind kind) {
+Status SortAndSweepBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, ProxyKind kind,
+                                              std::uint32_t group) {
   if (id < 0 || id > kMaxProxyId) {
     return Status::Error("broad phase: proxy id " + std::to_string(id) + " is outside [0, " +
                          std::to_string(kMaxProxyId) + "]");
@@ -95,6 +97,7 @@ Status SortAndSweepBroadPhase::AddProxyWithId(int id, const Aabb& aabb_world, Pr
   proxy.in_free_list = listed;
   proxy.aabb_world = aabb_world;
   proxy.kind = kind;
+  proxy.group = group;
   proxy.in_use = true;
   proxy.pending = true;
   // Appended after the sorted part; the next Update() moves the endpoints into
@@ -177,7 +180,10 @@ Status SortAndSweepBroadPhase::SetKind(int id, ProxyKind kind) {
     return Status::Ok();
   }
   for (std::uint32_t other : OverlappingInListOrder(slot)) {
-    if (proxies_[other].kind == ProxyKind::kDynamic) {
+    // A dynamic partner's pair stands either way; one of the same group
+    // never does.
+    const Proxy& partner = proxies_[other];
+    if (partner.kind == ProxyKind::kDynamic || (proxy.group != 0 && partner.group == proxy.group)) {
       continue;
     }
     if (is_dynamic) {
@@ -272,7 +278,7 @@ void SortAndSweepBroadPhase::RebuildFromScratch() {
       const Proxy& proxy = proxies_[id];
       for (std::uint32_t other : open) {
         const Proxy& other_proxy = proxies_[other];
-        if (PairIsReported(proxy.kind, other_proxy.kind) &&
+        if (PairIsReported(proxy.kind, other_proxy.kind, proxy.group, other_proxy.group) &&
             proxy.aabb_world.Overlaps(other_proxy.aabb_world)) {
           AddPair(PairKey(id, other));
         }
@@ -342,7 +348,8 @@ void SortAndSweepBroadPhase::InsertionSortAxis(int axis) {
       assert(passed.proxy != moving.proxy);
       if (moving.is_end != passed.is_end) {
         const Proxy& passed_proxy = proxies_[passed.proxy];
-        if (PairIsReported(moving_proxy.kind, passed_proxy.kind)) {
+        if (PairIsReported(moving_proxy.kind, passed_proxy.kind, moving_proxy.group,
+                           passed_proxy.group)) {
           const std::uint64_t key = PairKey(moving.proxy, passed.proxy);
           if (moving.is_end == 0) {
             if (moving_proxy.aabb_world.Overlaps(passed_proxy.aabb_world)) {

@@ -61,7 +61,8 @@ void WorldImpl::UpdateBroadPhase(const StepContext& step) {
       box = box.Fattened(margin);
     }
     if (!body.has_proxy) {
-      broad_phase_.AddProxyWithId(static_cast<int>(i), box, kind);
+      broad_phase_.AddProxyWithId(static_cast<int>(i), box, kind,
+                                  articulations_.CollisionGroup(body));
       body.has_proxy = true;
     } else {
       broad_phase_.SetAabb(static_cast<int>(i), box);
