@@ -432,5 +432,44 @@ TEST(ArticulationContactTest, BoxLetGoByAGripperFallsInsteadOfSleepingInTheAir) 
   EXPECT_LT(world.GetBody(box).linear_velocity.norm(), 0.05);
 }
 
+// A 0.2 m box on two sliding joints (x, then z through a link without
+// shape) above the 0.2 m box of its fixed base: two links not joined to
+// each other. Self-colliding, the top box falls 0.3 m and rests on the base
+// at z = 0.2 m; otherwise the broad phase never pairs them (one collision
+// group) and it falls freely: z = 0.5 - g t^2 / 2 after 1 s, to rounding.
+TEST(ArticulationContactTest, OnlyASelfCollidingArticulationTouchesItself) {
+  for (const bool self_collide : {true, false}) {
+    SCOPED_TRACE(self_collide);
+    World world = MakeWorld();
+    ArticulationDef def;
+    def.fixed_base = true;
+    def.self_collide = self_collide;
+    def.links.push_back(BoxLink(1.0, Vec3::Constant(0.2), 0.5));
+    LinkDef slider;
+    slider.mass_properties.mass = 1.0;
+    slider.mass_properties.inertia_about_com = Mat3::Identity() * 0.01;
+    def.links.push_back(slider);
+    def.links.push_back(BoxLink(1.0, Vec3::Constant(0.2), 0.5));
+    for (int i = 1; i <= 2; ++i) {
+      JointDef joint;
+      joint.name = "slide" + std::to_string(i);
+      joint.type = JointType::kPrismatic;
+      joint.parent_link = i - 1;
+      joint.child_link = i;
+      joint.axis = i == 1 ? Vec3::UnitX() : Vec3::UnitZ();
+      if (i == 2) joint.parent_from_joint.translation = Vec3(0, 0, 0.5);
+      def.joints.push_back(joint);
+    }
+    const ArticulationId id = world.CreateArticulation(def).value();
+    for (int step = 0; step < 240; ++step) world.Step();
+    const double z = world.GetPose(world.ArticulationLinks(id)[2]).translation.z();
+    if (self_collide) {
+      EXPECT_NEAR(z, 0.2, 2e-3);
+    } else {
+      EXPECT_NEAR(z, 0.5 - 0.5 * kG, 1e-9);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rigid_body_sim::physics::testing
