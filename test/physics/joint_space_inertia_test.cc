@@ -174,6 +174,30 @@ TEST(JointSpaceInertiaTest, ArticulatedBodyAlgorithmMatchesTheCompositeRigidBody
   EXPECT_EQ(compared, 40);
 }
 
+// An articulated-body evaluation of `model` at `state` with damping step
+// h, its response to M + h B captured, and the kinematics it read.
+ArticulatedResponse CaptureResponse(const ArticulationModel& model, const ArticulationState& state,
+                                    double h, ArticulationKinematics* kinematics) {
+  ComputeKinematics(model, state, kinematics, KinematicsParts::kPosesAndVelocities);
+  ArticulatedBodyScratch scratch;
+  Eigen::VectorXd acceleration;
+  ArticulatedBodyForwardDynamics(
+      {model, state, *kinematics, Vec3(0, 0, -9.81), Eigen::VectorXd::Zero(model.joint_dofs), h},
+      &scratch, &acceleration);
+  ArticulatedResponse response;
+  response.Capture(model, scratch);
+  return response;
+}
+
+// B: the joints' damping on the diagonal of their columns.
+Eigen::MatrixXd DampingMatrix(const ArticulationModel& model) {
+  Eigen::MatrixXd damping = Eigen::MatrixXd::Zero(model.DofCount(), model.DofCount());
+  for (const ArticulationJoint& joint : model.joints) {
+    damping(model.base_dofs + joint.dof, model.base_dofs + joint.dof) = joint.def.damping;
+  }
+  return damping;
+}
+
 // The row solve's M^-1 J^T of a large model from the articulated-body
 // passes (ArticulatedResponse) against the dense factor of M + h B, for
 // generalized forces of every kind: a joint's unit, a point force's row on
@@ -188,22 +212,10 @@ TEST(JointSpaceInertiaTest, ArticulatedResponseMatchesTheDenseFactor) {
         const ArticulationModel model = RandomTree(links, floating, &random, /*mimics=*/false);
         const ArticulationState state = RandomState(model, Vec3(3.0, -2.0, 1.0), &random);
         ArticulationKinematics kinematics;
-        ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
-        const Eigen::VectorXd efforts = Eigen::VectorXd::Zero(model.joint_dofs);
-        ArticulatedBodyScratch scratch;
-        Eigen::VectorXd acceleration;
-        ArticulatedBodyForwardDynamics(
-            {model, state, kinematics, Vec3(0, 0, -9.81), efforts, damping_step}, &scratch,
-            &acceleration);
-        ArticulatedResponse response;
-        response.Capture(model, scratch);
+        ArticulatedResponse response = CaptureResponse(model, state, damping_step, &kinematics);
         Eigen::MatrixXd mass;
         JointSpaceInertia(model, kinematics, &mass);
-        for (const ArticulationJoint& joint : model.joints) {
-          mass(model.base_dofs + joint.dof, model.base_dofs + joint.dof) +=
-              damping_step * joint.def.damping;
-        }
-        const Eigen::LLT<Eigen::MatrixXd> factor(mass);
+        const Eigen::LLT<Eigen::MatrixXd> factor(mass + damping_step * DampingMatrix(model));
         std::vector<Eigen::VectorXd> forces;
         forces.push_back(Eigen::VectorXd::Unit(model.DofCount(), model.DofCount() - 1));
         const int link = std::uniform_int_distribution<int>(1, links - 1)(random);
@@ -261,22 +273,11 @@ TEST(JointSpaceInertiaTest, FastestDampingRateRisesToTheGeneralizedEigenvalue) {
         }
         const ArticulationState state = RandomState(model, Vec3(1.0, 2.0, 0.5), &random);
         ArticulationKinematics kinematics;
-        ComputeKinematics(model, state, &kinematics, KinematicsParts::kPosesAndVelocities);
-        ArticulatedBodyScratch scratch;
-        Eigen::VectorXd acceleration;
-        ArticulatedBodyForwardDynamics({model, state, kinematics, Vec3(0, 0, -9.81),
-                                        Eigen::VectorXd::Zero(model.joint_dofs), h},
-                                       &scratch, &acceleration);
-        ArticulatedResponse response;
-        response.Capture(model, scratch);
+        ArticulatedResponse response = CaptureResponse(model, state, h, &kinematics);
         Eigen::MatrixXd mass;
         JointSpaceInertia(model, kinematics, &mass);
-        Eigen::MatrixXd damping = Eigen::MatrixXd::Zero(mass.rows(), mass.cols());
-        for (const ArticulationJoint& joint : model.joints) {
-          damping(model.base_dofs + joint.dof, model.base_dofs + joint.dof) = joint.def.damping;
-        }
         const double exact =
-            Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(damping, mass)
+            Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(DampingMatrix(model), mass)
                 .eigenvalues()
                 .maxCoeff();
         ASSERT_GT(exact, 0.0);
