@@ -30,6 +30,8 @@ constexpr double kLimitTolerance = 1e-6;
 // articulated-body passes, O(n) each, instead of the dense factor, O(n^3)
 // once and O(n^2) per row (bench figures in docs/performance.md).
 constexpr int kMostDenseResponseDofs = 24;
+// dt lambda above which joint damping is stiff for the free step's RK4.
+constexpr double kMaxDampingRate = 0.5;
 // The solver's state is refused beyond this size, as the step guard refuses
 // a body's (a step's products could overflow).
 constexpr double kMaxMagnitude = 1e100;
@@ -82,7 +84,6 @@ void CommandedEfforts(const ArticulationModel& model, const ArticulationState& s
 // base's mass and missed it.
 bool DampingIsStiff(const ArticulationModel& model, const ArticulationKinematics& kinematics,
                     double dt) {
-  constexpr double kMaxRate = 0.5;  // dt lambda
   if (!AnyJointDamped(model)) return false;
   Eigen::MatrixXd mass;
   JointSpaceInertia(model, kinematics, &mass);
@@ -94,7 +95,7 @@ bool DampingIsStiff(const ArticulationModel& model, const ArticulationKinematics
     const int column = model.base_dofs + joint.dof;
     rate += joint.def.damping * inverse(column, column);
   }
-  return dt * rate > kMaxRate;
+  return dt * rate > kMaxDampingRate;
 }
 
 // The same test for a model too large for the dense inverse (O(n^3) each
@@ -102,8 +103,7 @@ bool DampingIsStiff(const ArticulationModel& model, const ArticulationKinematics
 // instead of the trace's bound.
 bool LargeDampingIsStiff(const ArticulationModel& model, ArticulatedResponse* response, double dt,
                          DampingModeScratch* scratch) {
-  constexpr double kMaxRate = 0.5;  // dt lambda, as DampingIsStiff's
-  return dt * FastestDampingRate(model, dt, response, scratch) > kMaxRate;
+  return dt * FastestDampingRate(model, dt, response, scratch) > kMaxDampingRate;
 }
 
 // Per movable joint: its limits when the free step would reach them, its
