@@ -244,7 +244,9 @@ class ArticulatedResponse {
   std::vector<Vec6, Eigen::aligned_allocator<Vec6>> subspace_;  // per joint, S
   std::vector<Vec6, Eigen::aligned_allocator<Vec6>> scaled_;    // U / D
   std::vector<double> inverse_pivot_;                           // 1 / D
-  Eigen::LLT<Mat6> base_inertia_;                               // I^A of a floating base
+  // I^A of a floating base; the identity's until captured, so that a copy
+  // (the entries' vector growing) never reads an unset factor.
+  Eigen::LLT<Mat6> base_inertia_{Mat6::Identity()};
   // The passes': per link, the biases p^A and the accelerations; per joint
   // and force, u.
   Blocks<1> bias_one_, acceleration_one_;

@@ -16,7 +16,7 @@ void ArticulationSolver::Reset() {
 int ArticulationSolver::AddArticulation(const Eigen::VectorXd& u, const Eigen::MatrixXd& mass) {
   ArticulationSlot& slot = articulations_.emplace_back();
   slot.u = u;
-  slot.mass.compute(mass);
+  slot.mass.emplace(mass);
   return static_cast<int>(articulations_.size()) - 1;
 }
 
@@ -74,7 +74,7 @@ RowSide ArticulationSolver::ArticulationSide(int slot, const Eigen::VectorXd& ja
     articulation.response->Apply(jacobian, side.extent, &side.response);
   } else {
     side.extent = jacobian.size();
-    side.response = articulation.mass.solve(jacobian);
+    side.response = articulation.mass->solve(jacobian);
   }
   return side;
 }

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -95,7 +96,7 @@ class ArticulationSolver {
   // body passes (ArticulatedResponse), which must outlive the solve.
   struct ArticulationSlot {
     Eigen::VectorXd u;
-    Eigen::LLT<Eigen::MatrixXd> mass;
+    std::optional<Eigen::LLT<Eigen::MatrixXd>> mass;
     ArticulatedResponse* response = nullptr;
   };
 
