@@ -7,8 +7,9 @@
 // rigid bodies it touches, and an impulse lambda_k. Its velocity is
 // v_k = J_k u. The effect of an impulse is u += M^-1 J_k^T lambda_k, made
 // once per row and step (for an articulation, the dense solve with the
-// joint-space inertia; for a rigid body, d/m and I^-1 (r x d)), so a sweep
-// costs O(dofs) per row. This is the generalized form of the contact
+// joint-space inertia's factor, or above 24 dofs the articulated-body
+// passes of ArticulatedResponse; for a rigid body, d/m and I^-1 (r x d)),
+// so a sweep costs O(dofs) per row. This is the generalized form of the contact
 // problem of Baraff 1996, "Linear-Time Dynamics using Lagrange Multipliers",
 // section 7 (contact and joint limits as unilateral rows), solved with the
 // Delassus operator J M^-1 J^T applied implicitly (Erleben 2007,
