@@ -154,6 +154,11 @@ class ArticulationSystem {
   void BounceLinkContacts(const StepContext& step, const std::vector<int>& slot_of_articulation);
   std::vector<double> LinkImpactTimes(const StepContext& step,
                                       const std::vector<int>& slot_of_articulation);
+  void FindApproachVelocities();
+  double LinkPairImpactTime(const StepContext& step, const std::vector<int>& slot_of_articulation,
+                            const ShapePairContact& pair, double closing_speed);
+  Pose BodyPoseOnImpactPath(std::uint32_t index, const std::vector<int>& slot_of_articulation,
+                            double t);
   void CorrectLinkPenetration(const StepContext& step,
                               const std::vector<int>& slot_of_articulation);
   void RecordJointEfforts(const StepContext& step);
@@ -181,6 +186,9 @@ class ArticulationSystem {
   // Per articulation slot, its velocity before the bouncing points'
   // impulses (LinkImpactTimes).
   std::vector<Eigen::VectorXd> approach_velocities_;
+  // BodyPoseOnImpactPath's state and kinematics at a time of the path.
+  ArticulationState impact_state_;
+  ArticulationKinematics impact_kinematics_;
   // The rigid bodies' velocities of the link solve before its restitution
   // pass, per body slot; empty when no point bounced this step.
   std::vector<ArticulationSolver::BodySlot> solved_bodies_;

@@ -1,7 +1,7 @@
-// The contacts of links: their rows in the articulations' solve, their
-// restitution at the time they touch, the split impulse that lifts a link
-// out of what it penetrates, and their reports (docs/design.md,
-// "Articulated bodies").
+// The contacts of links: their rows in the articulations' solve, the split
+// impulse that lifts a link out of what it penetrates, and their reports
+// (docs/design.md, "Articulated bodies"); their restitution at the time they
+// touch is link_impacts.cc.
 #include <algorithm>
 #include <array>
 
@@ -138,115 +138,6 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
     solver_.AddRow(std::move(tangent_row));
   }
   return normal_index;
-}
-
-// Restitution of the link contacts that close within the step, at the
-// time they touch. A point still apart at the start of the step is stopped
-// where it touches by its row, v+ >= -s / dt. The velocity each
-// articulation had before those rows stopped it, u- = u - M^-1 J^T lambda
-// over their impulses (normal and friction), reaches the touch at
-// t_c = s / (-J u-), the earliest over its points: in joint coordinates the
-// step moves on the straight line q + t u, so the gap closes linearly. The
-// rows that took an impulse are then solved again, the others' impulses
-// held, for v+ >= -e v-, the speed it leaves with (Baraff 1997, "Rigid Body
-// Simulation II", section 8, the collision impulse at the time of contact),
-// and the articulation ends the step at q + t_c u- + (dt - t_c) u+, as a
-// rigid body does in the sub-step after its impact. A point whose other
-// side is a moving rigid body keeps the end of the step as its time: the
-// body's drift is the contact solver's (the restitution pass after the
-// position update of Box2D v3.0, Catto 2024, contact_solver.c).
-void ArticulationSystem::BounceLinkContacts(const StepContext& step,
-                                            const std::vector<int>& slot_of_articulation) {
-  std::vector<std::size_t>& bouncing = bouncing_rows_;
-  bouncing.clear();
-  solved_bodies_.clear();
-  std::vector<ConstraintRow>& rows = solver_.rows();
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (rows[k].bounce > 0.0 && rows[k].impulse > 0.0) bouncing.push_back(k);
-  }
-  if (bouncing.empty()) return;
-  const std::vector<double> impact_times = LinkImpactTimes(step, slot_of_articulation);
-  for (const std::size_t k : bouncing) {
-    rows[k].target = rows[k].bounce;
-    rows[k].colliding = true;
-  }
-  solved_bodies_ = solver_.bodies();
-  solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
-  for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
-    const int slot = slot_of_articulation[i];
-    if (slot < 0) continue;
-    ArticulationEntry& entry = articulations_[i];
-    const Eigen::VectorXd& u_after = solver_.articulations()[slot].u;
-    const double t_c = impact_times[slot];
-    if (t_c < step.dt) {
-      const ArticulationState at_impact =
-          Advance(entry.model, entry.state, approach_velocities_[slot], t_c);
-      entry.next = Advance(entry.model, at_impact, u_after, step.dt - t_c);
-    }
-    entry.next.u = u_after;
-  }
-}
-
-// Per articulation slot, the time its first bouncing point touches (dt
-// when none is timed), and in approach_velocities_ its velocity before the
-// bouncing points' impulses; a timed point's bounce becomes -e times the
-// speed it strikes with. Reads the rows before their bounce targets.
-std::vector<double> ArticulationSystem::LinkImpactTimes(
-    const StepContext& step, const std::vector<int>& slot_of_articulation) {
-  std::vector<ConstraintRow>& rows = solver_.rows();
-  std::vector<ArticulationSolver::ArticulationSlot>& slots = solver_.articulations();
-  approach_velocities_.resize(slots.size());
-  for (std::size_t slot = 0; slot < slots.size(); ++slot)
-    approach_velocities_[slot] = slots[slot].u;
-  const auto remove_impulse = [&](const ConstraintRow& row) {
-    for (const RowSide* side : {&row.a, &row.b}) {
-      if (side->kind == RowSide::Kind::kArticulation) {
-        approach_velocities_[side->slot] -= row.impulse * side->response;
-      }
-    }
-  };
-  for (const std::size_t k : bouncing_rows_) {
-    remove_impulse(rows[k]);
-    for (std::size_t t = k + 1; t <= k + 2 && t < rows.size(); ++t) {
-      if (rows[t].kind == RowKind::kTangent && rows[t].normal_row == static_cast<int>(k)) {
-        remove_impulse(rows[t]);
-      }
-    }
-  }
-  std::vector<Eigen::VectorXd> start_velocities(slots.size());
-  for (std::size_t i = 0; i < articulations_.size(); ++i) {
-    const int slot = slot_of_articulation[i];
-    if (slot >= 0) start_velocities[slot] = articulations_[i].state.u;
-  }
-  std::vector<double> times(slots.size(), step.dt);
-  for (const std::size_t k : bouncing_rows_) {
-    const ConstraintRow& row = rows[k];
-    if (row.a.kind == RowSide::Kind::kBody || row.b.kind == RowSide::Kind::kBody) continue;
-    double closing = 0.0;  // J u-, m/s
-    for (const RowSide* side : {&row.a, &row.b}) {
-      if (side->kind == RowSide::Kind::kArticulation) {
-        closing += side->jacobian.dot(approach_velocities_[side->slot]);
-      }
-    }
-    const double gap = -row.target * step.dt;  // s of the target -s / dt
-    if (!(closing < 0.0) || !(gap >= 0.0)) continue;
-    const double time = std::min(gap / -closing, step.dt);
-    // It strikes with u_c = u(t_c) = u + (t_c / dt) (u- - u) (the forces
-    // act evenly over the step) and leaves with w, J w = -e J u_c; the
-    // forces then act over the rest of the step, u+ = w + (u- - u_c). So
-    // the row's target for u+ is -e J u_c + J (u- - u_c).
-    double closing_at_impact = 0.0;
-    for (const RowSide* side : {&row.a, &row.b}) {
-      if (side->kind != RowSide::Kind::kArticulation) continue;
-      times[side->slot] = std::min(times[side->slot], time);
-      const Eigen::VectorXd& start = start_velocities[side->slot];
-      closing_at_impact +=
-          side->jacobian.dot(start + (time / step.dt) * (approach_velocities_[side->slot] - start));
-    }
-    rows[k].bounce =
-        std::max(0.0, -row.restitution * closing_at_impact + (closing - closing_at_impact));
-  }
-  return times;
 }
 
 // The split impulse of the link contacts (the rigid bodies' is in

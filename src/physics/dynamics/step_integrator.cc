@@ -7,15 +7,13 @@
 
 #include "physics/collision/narrow_phase.h"
 #include "physics/dynamics/integrator.h"
+#include "physics/dynamics/time_of_impact.h"
 #include "physics/geometry/shape_bounds.h"
 #include "physics/world/union_find.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
 namespace {
-
-// Bisection stops when the bracket is shorter than this fraction of the step.
-constexpr double kTimeOfImpactTolerance = 1e-6;
 
 // Samples along a fast body's path, at most: 2 km/s against a 1 mm thick
 // plate at 240 Hz.
@@ -79,53 +77,6 @@ struct PairSweep {
 double ShapeRadius(const ShapeGeometry& geometry) {
   if (std::holds_alternative<HalfSpace>(geometry)) return std::numeric_limits<double>::infinity();
   return ShapeBoundingRadius(geometry, Vec3::Zero());
-}
-
-// Times with gap(low) > target_gap >= gap(high).
-struct ImpactBracket {
-  double low = 0.0;       // s
-  double gap_low = 0.0;   // m
-  double high = -1.0;     // s; < 0 while no sample touched
-  double gap_high = 0.0;  // m
-};
-
-// Regula falsi on gap(t) = aim, keeping the bracket gap(low) > target_gap >=
-// gap(high) (Illinois: the end kept twice in a row has its value halved, so
-// it converges superlinearly instead of creeping; Dowell and Jarratt, "A
-// modified regula falsi method for computing the root of an equation",
-// BIT 11, 1971). It ends when `low` is within a tenth of the touching band
-// above target_gap, so the free flight is cut short by at most that much,
-// or when the bracket is within tolerance, as plain bisection would.
-// Returns the narrowed bracket, whose legal end is `low`.
-ImpactBracket NarrowImpactBracket(const PairSweep& sweep, double target_gap, double touching,
-                                  double dt, ImpactBracket bracket) {
-  const double close_enough = target_gap + 0.1 * (touching - target_gap);
-  const double aim = target_gap + 0.05 * (touching - target_gap);
-  int kept_side = 0;  // -1: low was kept last time, +1: high
-  double weight_low = 1.0;
-  double weight_high = 1.0;
-  while (bracket.gap_low > close_enough &&
-         bracket.high - bracket.low > kTimeOfImpactTolerance * dt) {
-    const double f_low = weight_low * (bracket.gap_low - aim);
-    const double f_high = weight_high * (bracket.gap_high - aim);
-    double t = bracket.low + (bracket.high - bracket.low) * f_low / (f_low - f_high);
-    if (!(t > bracket.low && t < bracket.high)) t = 0.5 * (bracket.low + bracket.high);
-    const double gap = sweep.GapAt(t);
-    if (gap > target_gap) {
-      bracket.low = t;
-      bracket.gap_low = gap;
-      weight_low = 1.0;
-      weight_high = kept_side == 1 ? 0.5 * weight_high : 1.0;
-      kept_side = 1;
-    } else {
-      bracket.high = t;
-      bracket.gap_high = gap;
-      weight_high = 1.0;
-      weight_low = kept_side == -1 ? 0.5 * weight_low : 1.0;
-      kept_side = -1;
-    }
-  }
-  return bracket;
 }
 
 }  // namespace
@@ -340,7 +291,8 @@ double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair
   // by its reuse error, and a pair backed up to t = 0 again and again would
   // never reach the solver).
   pair->anchors.valid = false;
-  bracket = NarrowImpactBracket(sweep, target_gap, touching, step.dt, bracket);
+  bracket = NarrowImpactBracket([&sweep](double t) { return sweep.GapAt(t); },
+                                ImpactTarget{target_gap, touching}, step.dt, bracket);
   // The gap's rate over the final bracket: the speed the surfaces meet at.
   *approach_speed = (bracket.gap_low - bracket.gap_high) / (bracket.high - bracket.low);
   return bracket.low;
