@@ -189,9 +189,41 @@ void ArticulationSystem::TakeLinkPairs(const std::vector<ShapePairContact*>& tou
                                        std::vector<ShapePairContact*>* rigid_pairs) {
   rigid_pairs->clear();
   link_pairs_.clear();
+  const auto has_link = [this](const ShapePairContact& pair) {
+    return bodies_[pair.body_a].articulation >= 0 || bodies_[pair.body_b].articulation >= 0;
+  };
+  if (std::none_of(touching.begin(), touching.end(),
+                   [&](const ShapePairContact* pair) { return has_link(*pair); })) {
+    *rigid_pairs = touching;
+    return;
+  }
+  // The islands of moving rigid bodies, joined by their touching pairs (a
+  // static or sleeping body joins none: it takes no impulse).
+  const auto moves = [this](std::uint32_t index) {
+    const Body& body = bodies_[index];
+    return body.articulation < 0 && !body.is_static && body.awake && !body.disabled &&
+           body.inverse_mass > 0.0;
+  };
+  UnionFind& islands = link_islands_;
+  islands.Reset(bodies_.size());
+  for (const ShapePairContact* pair : touching) {
+    if (!has_link(*pair) && moves(pair->body_a) && moves(pair->body_b))
+      islands.Join(pair->body_a, pair->body_b);
+  }
+  std::vector<char>& with_link = island_touches_link_;
+  with_link.assign(bodies_.size(), 0);
+  for (const ShapePairContact* pair : touching) {
+    if (!has_link(*pair)) continue;
+    for (const std::uint32_t body : {pair->body_a, pair->body_b}) {
+      if (moves(body)) with_link[islands.Find(body)] = 1;
+    }
+  }
+  const auto in_link_island = [&](std::uint32_t body) {
+    return moves(body) && with_link[islands.Find(body)] != 0;
+  };
   for (ShapePairContact* pair : touching) {
     const bool link =
-        bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0;
+        has_link(*pair) || in_link_island(pair->body_a) || in_link_island(pair->body_b);
     (link ? link_pairs_ : *rigid_pairs).push_back(pair);
   }
 }

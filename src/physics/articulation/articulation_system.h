@@ -16,6 +16,7 @@
 #include "physics/articulation/free_motion.h"
 #include "physics/contact/contact_cache.h"
 #include "physics/world/step_context.h"
+#include "physics/world/union_find.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
@@ -176,6 +177,8 @@ class ArticulationSystem {
   std::vector<int> slot_scratch_;                // Solve's, per articulation
   Eigen::VectorXd acceleration_scratch_;
   std::vector<ShapePairContact*> link_pairs_;  // TakeLinkPairs'
+  UnionFind link_islands_;                     // TakeLinkPairs' scratch
+  std::vector<char> island_touches_link_;      // TakeLinkPairs' scratch, per island root
   // Per link pair, the index of its first normal row, or -1.
   std::vector<int> link_pair_rows_;
   // The normal rows of link contacts penetrating beyond the slop, each with
