@@ -169,7 +169,7 @@ void ArticulationSolver::ApplyImpulse(const ConstraintRow& row, double impulse) 
 // tangential velocity, then the pair is projected onto the disc
 // |lambda_t| <= mu lambda_n (a circular Coulomb cone). Returns the largest
 // change.
-double ArticulationSolver::UpdateFriction(std::size_t k) {
+double ArticulationSolver::UpdateFriction(std::size_t k, double* speed) {
   ConstraintRow& t0 = rows_[k];
   ConstraintRow& t1 = rows_[k + 1];
   const double limit = t0.friction * rows_[t0.normal_row].impulse;
@@ -187,6 +187,10 @@ double ArticulationSolver::UpdateFriction(std::size_t k) {
   t1.impulse = l1;
   ApplyImpulse(t0, change0);
   ApplyImpulse(t1, change1);
+  if (speed != nullptr) {
+    *speed = std::max(t0.inverse_mass > 0.0 ? std::abs(change0) / t0.inverse_mass : 0.0,
+                      t1.inverse_mass > 0.0 ? std::abs(change1) / t1.inverse_mass : 0.0);
+  }
   return std::max(std::abs(change0), std::abs(change1));
 }
 
@@ -197,7 +201,7 @@ double ArticulationSolver::UpdateFriction(std::size_t k) {
 // the projection being onto [lower, upper], onto lambda >= 0 for a normal,
 // and onto the friction disc for a tangent pair. The warm start's impulses
 // are applied first.
-int ArticulationSolver::Solve(int max_sweeps, double tolerance) {
+int ArticulationSolver::Solve(const SweepLimits& limits) {
   for (ConstraintRow& row : rows_) {
     const double response = SideResponse(row.a) + SideResponse(row.b) + row.softness;
     row.inverse_mass = response > 0.0 ? 1.0 / response : 0.0;
@@ -205,25 +209,44 @@ int ArticulationSolver::Solve(int max_sweeps, double tolerance) {
     if (row.kind == RowKind::kNormal) row.impulse = std::max(row.impulse, 0.0);
     if (row.impulse != 0.0) ApplyImpulse(row, row.impulse);
   }
+  const bool by_speed = limits.contact_speed > 0.0;
+  const auto rigid = [](const ConstraintRow& row) {
+    return row.a.kind != RowSide::Kind::kArticulation && row.b.kind != RowSide::Kind::kArticulation;
+  };
   int sweep = 0;
-  while (sweep < max_sweeps) {
+  while (sweep < limits.max_sweeps) {
     ++sweep;
+    const bool sweep_rigid = sweep <= limits.rigid_sweeps;
     double largest = 0.0;
     double scale = 0.0;
+    double fastest = 0.0;  // m/s, of the contact rows judged by speed
     for (std::size_t k = 0; k < rows_.size(); ++k) {
       ConstraintRow& row = rows_[k];
+      const bool held = !sweep_rigid && rigid(row);
       // A tangent row is always taken with its pair, even one that moves
       // nothing (a cart on a rail across it): skipping it alone would take
       // its pair for the first of a pair, and the row after for its pair.
       if (row.kind == RowKind::kTangent) {
-        largest = std::max(largest, UpdateFriction(k));
+        double speed = 0.0;
+        const double change = held ? 0.0 : UpdateFriction(k, by_speed ? &speed : nullptr);
+        if (by_speed) {
+          fastest = std::max(fastest, speed);
+        } else {
+          largest = std::max(largest, change);
+        }
         ++k;  // its pair was updated with it
         continue;
       }
-      largest = std::max(largest, UpdateRow(&row));
+      const double change = held ? 0.0 : UpdateRow(&row);
+      if (by_speed && row.joint < 0) {
+        if (row.inverse_mass > 0.0) fastest = std::max(fastest, change / row.inverse_mass);
+      } else {
+        largest = std::max(largest, change);
+      }
       scale = std::max(scale, std::abs(row.impulse));
     }
-    if (largest <= tolerance * std::max(scale, 1e-12)) break;
+    if (largest <= limits.tolerance * std::max(scale, 1e-12) && fastest <= limits.contact_speed)
+      break;
   }
   return sweep;
 }

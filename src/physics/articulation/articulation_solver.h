@@ -119,9 +119,25 @@ class ArticulationSolver {
   RowSide BodySide(int slot, const Vec3& direction, const Vec3& lever_arm) const;
   int AddRow(ConstraintRow row);
 
+  // When the sweeps of Solve stop.
+  struct SweepLimits {
+    int max_sweeps = 0;
+    double tolerance = 0.0;  // of an impulse's change, relative to the largest impulse
+    // m/s; > 0: a contact point's rows are judged instead by the velocity
+    // their change makes, |d lambda| J M^-1 J^T, as the rigid solver
+    // judges its points (SolverSettings::velocity_tolerance).
+    double contact_speed = 0.0;
+    // Rows between rigid bodies alone (of an island a link touches) are
+    // swept at most this often, as the rigid solver sweeps its points
+    // (SolverSettings::velocity_iterations); later sweeps hold them, and a
+    // contact the link rows then push further is held out of the body by
+    // the split impulse beyond the slop, as the rigid solver holds it.
+    int rigid_sweeps = std::numeric_limits<int>::max();
+  };
   // Projected Gauss-Seidel until no impulse changes by more than
   // `tolerance` (relative to its size) or `max_sweeps`. Returns the sweeps.
-  int Solve(int max_sweeps, double tolerance);
+  int Solve(int max_sweeps, double tolerance) { return Solve(SweepLimits{max_sweeps, tolerance}); }
+  int Solve(const SweepLimits& limits);
   // Further sweeps over the given rows only (none a tangent), the other
   // rows' impulses held; returns the sweeps.
   int SweepRows(const std::vector<std::size_t>& rows, int max_sweeps, double tolerance);
@@ -139,7 +155,9 @@ class ArticulationSolver {
   // One projected Gauss-Seidel update of a normal or bounded row; returns
   // |change of its impulse|.
   double UpdateRow(ConstraintRow* row);
-  double UpdateFriction(std::size_t k);
+  // The same for a point's two friction rows together; `speed` gets the
+  // larger of the velocities their changes make.
+  double UpdateFriction(std::size_t k, double* speed = nullptr);
 
   std::vector<ArticulationSlot> articulations_;
   std::vector<BodySlot> bodies_;

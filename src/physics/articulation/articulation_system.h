@@ -178,7 +178,10 @@ class ArticulationSystem {
   Eigen::VectorXd acceleration_scratch_;
   std::vector<ShapePairContact*> link_pairs_;  // TakeLinkPairs'
   UnionFind link_islands_;                     // TakeLinkPairs' scratch
-  std::vector<char> island_touches_link_;      // TakeLinkPairs' scratch, per island root
+  // TakeLinkPairs' scratch, per body: bit 0 counted, bit 1 (of a root)
+  // its island touches a link; and per root its size.
+  std::vector<char> island_touches_link_;
+  std::vector<std::uint32_t> island_sizes_;
   // Per link pair, the index of its first normal row, or -1.
   std::vector<int> link_pair_rows_;
   // The normal rows of link contacts penetrating beyond the slop, each with
