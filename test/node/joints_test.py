@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Articulated models through the ROS interface: joint_states, joint_command,
-joint_trajectory, ~set_joint_state, ~reset, tf, against closed forms.
+joint_trajectory, ~set_joint_state, ~reset, tf, a link's impact, against closed forms.
 
 Run by joints_test.test: the node starts paused with its ground plane; every
 test spawns models of its own and steps the world with ~step.
@@ -25,6 +25,34 @@ PKG = 'rigid_body_sim'
 SIM = '/rigid_body_sim/'
 G = 9.81
 DT = 1.0 / 240.0
+
+# A 1 kg ball of radius 0.01 m on a massless 1 m arm, hinged about z at the
+# spawn pose, fixed to 'world'.
+STRIKER_URDF = """<robot name="striker">
+  <link name="world"/>
+  <joint name="mount" type="fixed"><parent link="world"/><child link="pivot"/></joint>
+  <link name="pivot">
+    <inertial><mass value="0.1"/>
+      <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>
+  </link>
+  <joint name="hinge" type="continuous">
+    <parent link="pivot"/><child link="arm"/><axis xyz="0 0 1"/>
+  </joint>
+  <link name="arm">
+    <inertial><origin xyz="1 0 0"/><mass value="1"/>
+      <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="1 0 0"/><geometry><sphere radius="0.01"/></geometry></collision>
+  </link>
+</robot>"""
+
+# A 0.2 m box of 1 kg.
+BOX_URDF = """<robot name="box">
+  <link name="box">
+    <inertial><mass value="1"/>
+      <inertia ixx="0.00667" iyy="0.00667" izz="0.00667" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
+  </link>
+</robot>"""
 
 
 def service(name, service_type):
@@ -236,6 +264,66 @@ class JointsTest(unittest.TestCase):
         self.assertAlmostEqual(5.0 - 0.5 * G * t * t, cart.z, delta=1e-9)
         self.assertAlmostEqual(8.0, cart.x, delta=1e-12)
         self.assertAlmostEqual(0.0, cart.y, delta=1e-12)
+
+    def test_hinged_link_strikes_a_static_box_at_the_contact_time(self):
+        """A 1 m arm on a hinge about z (gravity gives it no torque) swings its 1 cm ball into
+        the face y = 0 of a static box at 3 m/s, e = 0.5: the impact step ends at
+        theta_c - e omega (t - t_c), with theta_c = -asin(r / L) and t_c = 5.37 steps, and
+        the arm leaves at -e omega to 1e-6 relative."""
+        length, radius, restitution, speed, steps_to_impact = 1.0, 0.01, 0.5, 3.0, 5.37
+        contact_angle = -math.asin(radius / length)
+        omega = speed / (length * math.cos(contact_angle))
+        start_angle = contact_angle - omega * steps_to_impact * DT
+        striker = SpawnRequest()
+        striker.name = 'striker'
+        striker.urdf = STRIKER_URDF
+        striker.pose.position.x = -6.0
+        striker.pose.position.z = 1.0
+        striker.pose.orientation.w = 1.0
+        striker.friction = 0.0
+        striker.restitution = restitution
+        striker.joint_names = ['hinge']
+        striker.joint_positions = [start_angle]
+        response = self.spawn(striker)
+        self.assertTrue(response.success, response.message)
+        self.addCleanup(self.delete, 'striker')
+        wall = SpawnRequest()
+        wall.name = 'struck_box'
+        wall.urdf = BOX_URDF
+        wall.pose.position.x = -6.0 + length
+        wall.pose.position.y = 0.1
+        wall.pose.position.z = 1.0
+        wall.pose.orientation.w = 1.0
+        wall.is_static = True
+        wall.friction = 0.0
+        wall.restitution = restitution
+        response = self.spawn(wall)
+        self.assertTrue(response.success, response.message)
+        self.addCleanup(self.delete, 'struck_box')
+        request = SetJointStateRequest()
+        request.name = 'striker'
+        request.joint_names = ['hinge']
+        request.positions = [start_angle]
+        request.velocities = [omega]
+        response = self.set_joint_state(request)
+        self.assertTrue(response.success, response.message)
+
+        def arm_angle_and_rate():
+            state = self.get_state('striker/arm')
+            self.assertTrue(state.success, state.message)
+            rotation = state.pose.orientation
+            return 2.0 * math.atan2(rotation.z, rotation.w), state.twist.angular.z
+
+        steps = 0
+        angle, rate = arm_angle_and_rate()
+        while steps < 20 and rate > 0.0:
+            self.step(1)
+            steps += 1
+            angle, rate = arm_angle_and_rate()
+        self.assertEqual(6, steps)
+        expected = contact_angle - restitution * omega * (steps * DT - steps_to_impact * DT)
+        self.assertAlmostEqual(expected, angle, delta=1e-8)
+        self.assertAlmostEqual(1.0, rate / (-restitution * omega), delta=1e-6)
 
     def test_trajectory_reaches_its_points_on_time(self):
         self.spawn_urdf('arm3', 'two_link_arm.urdf', 1.5)
