@@ -291,4 +291,25 @@ void WorldImpl::CollideShapePair(NarrowJob* job) const {
   AnchorManifold(b_from_a, world_from_shape_a, world_from_shape_b, &entry);
 }
 
+// The pair's manifold clipped afresh at the current poses.
+void WorldImpl::RecollidePair(const StepContext& step, ShapePairContact* pair) {
+  const Body& a = bodies_[pair->body_a];
+  const Body& b = bodies_[pair->body_b];
+  const ShapeDef& shape_a = a.shapes[pair->shape_a];
+  const ShapeDef& shape_b = b.shapes[pair->shape_b];
+  CollideInput input;
+  input.a = &shape_a.geometry;
+  input.world_from_a = a.WorldFromBody() * shape_a.body_from_shape;
+  input.b = &shape_b.geometry;
+  input.world_from_b = b.WorldFromBody() * shape_b.body_from_shape;
+  input.contact_distance = ContactDistance(a, b, step);
+  pair->contact_distance = input.contact_distance;
+  CollideStats stats;
+  Collide(input, &pair->witness, &pair->manifold, &stats);
+  pair->apart_gap =
+      pair->manifold.point_count == 0 ? stats.gap : -std::numeric_limits<double>::infinity();
+  pair->apart_travel = a.travel + b.travel;
+  pair->anchors.valid = false;
+}
+
 }  // namespace rigid_body_sim::physics

@@ -31,13 +31,6 @@
 
 namespace rigid_body_sim::physics {
 
-// A pair that comes into contact within a (sub)step, and when.
-struct Impact {
-  ShapePairContact* pair = nullptr;
-  double time = 0.0;       // s from the (sub)step's start
-  bool colliding = false;  // the surfaces meet faster than collision_velocity_threshold
-};
-
 // A shape pair the narrow phase tests this step (stage 2): its cache entry,
 // which holds the bodies, shapes and contact distance, and the summed travel
 // of the two bodies (Body::travel). Jobs write only their own entry, so any
@@ -104,7 +97,7 @@ class WorldImpl : public LinkBodies {
   }
 
  private:
-  friend class ExactSolver;     // runs stages 4 and 5 below
+  friend class ExactSolver;     // runs stages 4 and 5 (solver/exact_solver.h)
   friend class SoftStepSolver;  // likewise, with its own sub-steps
 
   Body& MutableBody(BodyId id);
@@ -121,34 +114,16 @@ class WorldImpl : public LinkBodies {
   void UpdateBroadPhase(const StepContext& step);   // 1. broad phase: swept boxes, candidate pairs
   void UpdateNarrowPhase(const StepContext& step);  // 2. narrow phase: manifolds per shape pair
   void UpdateContactCache();                        // 3. contact cache: witnesses, warm starts
-  void SolveContacts(const StepContext& step);  // 4. solver: collisions, forces, resting contact
+  // 4 and 5, from velocities to poses, are motion_solver_'s (solver/).
   // The awake, enabled bodies that are not links into moving_bodies_.
   void ListMovingBodies();
-  // Stage 4's parts (step_solver.cc).
-  void SolveTouching(const StepContext& step, const std::vector<ShapePairContact*>& pairs);
-  void HoldPushedBodies();
+  // What both solvers' stage 4 shares (step_solver.cc).
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
   void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
                       bool impacts_only);
   void ReportSleepingContacts(const StepContext& step);
-  void IntegrateBodies(const StepContext& step);  // 5. integrator: drift, time of impact, sleep
-  // Stage 5's parts (step_integrator.cc, step_impacts.cc).
-  void CapSpin(const StepContext& step);
-  void DriftBodies(const StepContext& step);
-  void BoundBodyMotion(const StepContext& step);
-  std::vector<Impact> FindImpacts(const StepContext& step,
-                                  const std::vector<ShapePairContact*>& pairs);
-  // Time of impact within dt, or +infinity; with the speed the surfaces
-  // meet at, m/s.
-  double PairImpactTime(const StepContext& step, ShapePairContact* pair, double* approach_speed);
-  void ResolveImpacts(const StepContext& step, const std::vector<Impact>& impacts,
-                      const std::vector<ShapePairContact*>& touching, int round);
-  void BackUpBody(std::uint32_t index, double time);
-  void SubStep(const std::vector<std::uint32_t>& island, const StepContext& step, int round);
+  // The pair's manifold clipped afresh at the current poses (step_narrow_phase.cc).
   void RecollidePair(const StepContext& step, ShapePairContact* pair);
-  int PathSamples(std::uint32_t body_a, std::uint32_t body_b) const;
-  double PairThickness(const ShapePairContact& pair) const;
-  double PairStartGap(const ShapePairContact& pair) const;
   // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
   // a static mesh's are tested at once.
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const StepContext& step);
@@ -160,6 +135,7 @@ class WorldImpl : public LinkBodies {
                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
                       const Pose& world_from_shape_b, ShapePairContact* entry) const;
+  // Stage 5's end, both solvers' (dynamics/step_sleep.cc).
   void UpdateSleep(const StepContext& step);
   bool UpdateSpeedingUp(const StepContext& step, Body* body) const;
   void DisableNonFiniteBodies();
@@ -180,14 +156,7 @@ class WorldImpl : public LinkBodies {
   std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
   std::unique_ptr<MotionSolver> motion_solver_;  // settings_.motion_solver
   std::vector<NarrowJob> narrow_jobs_;           // stage 2's, in the order the pairs were visited
-  // FindImpacts' per pair: the time of impact (s, +infinity for none) and
-  // the speed the surfaces meet at (m/s).
-  struct ImpactSearch {
-    double time = 0.0;
-    double approach_speed = 0.0;
-  };
-  std::vector<ImpactSearch> impact_searches_;
-  std::vector<Body> bodies_;  // slots; a destroyed body's slot is reused
+  std::vector<Body> bodies_;                     // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;
   double time_ = 0.0;
@@ -202,9 +171,6 @@ class WorldImpl : public LinkBodies {
   std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
   std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
-  std::vector<Vec3> push_normals_;            // HoldPushedBodies' scratch, per body slot
-  std::vector<std::uint8_t> push_state_;      // 0 not pushed, 1 along one normal, 2 several
-  std::vector<BodyPath> paths_;               // stage 5's, per body slot (IntegrateBodies)
   std::vector<SleepWindow> sleep_windows_;    // the sleep test's, per body slot (UpdateSleep)
   // UpdateSleep's per-step buffers, kept so that a step does not allocate.
   struct SleepScratch {

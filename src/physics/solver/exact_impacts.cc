@@ -1,4 +1,4 @@
-// The rest of a step after an impact (stage 5 continued). A body that would
+// The exact solver's rest of a step after an impact (stage 5 continued). A body that would
 // enter another within the step is backed up to the time of impact
 // (Baraff 1997, "Rigid Body Simulation II", section 6), and then, instead of
 // losing what is left of the step, it and everything that touches it
@@ -12,6 +12,7 @@
 #include <numeric>
 
 #include "physics/collision/narrow_phase.h"
+#include "physics/solver/exact_solver.h"
 #include "physics/world/union_find.h"
 #include "physics/world/world_impl.h"
 
@@ -35,15 +36,15 @@ constexpr std::size_t kMaxSubStepBodies = 32;
 // (linked by touching pairs and by colliding impacts) that holds a colliding
 // impact goes back to its earliest impact and simulates the rest of h. A
 // body with only other impacts stays at its own earliest one.
-void WorldImpl::ResolveImpacts(const StepContext& step, const std::vector<Impact>& impacts,
-                               const std::vector<ShapePairContact*>& touching, int round) {
-  const std::vector<std::uint32_t> moving = moving_bodies_;
+void ExactSolver::ResolveImpacts(const StepContext& step, const std::vector<Impact>& impacts,
+                                 const std::vector<ShapePairContact*>& touching, int round) {
+  const std::vector<std::uint32_t> moving = world_.moving_bodies_;
   std::vector<std::vector<std::uint32_t>> islands;
   std::vector<double> island_times;
   if (!impacts.empty()) {
-    std::vector<double> body_time(bodies_.size(), std::numeric_limits<double>::infinity());
+    std::vector<double> body_time(world_.bodies_.size(), std::numeric_limits<double>::infinity());
     UnionFind sets;
-    sets.Reset(bodies_.size());
+    sets.Reset(world_.bodies_.size());
     const auto moves = [&](std::uint32_t body) { return paths_[body].dt > 0.0; };
     for (const ShapePairContact* pair : touching) {
       if (moves(pair->body_a) && moves(pair->body_b)) sets.Join(pair->body_a, pair->body_b);
@@ -58,8 +59,8 @@ void WorldImpl::ResolveImpacts(const StepContext& step, const std::vector<Impact
     }
     // An island's time is its earliest impact; only an island with a
     // colliding impact goes on to the end of the interval.
-    std::vector<double> root_time(bodies_.size(), std::numeric_limits<double>::infinity());
-    std::vector<char> root_collides(bodies_.size(), 0);
+    std::vector<double> root_time(world_.bodies_.size(), std::numeric_limits<double>::infinity());
+    std::vector<char> root_collides(world_.bodies_.size(), 0);
     for (const Impact& impact : impacts) {
       for (const std::uint32_t body : {impact.pair->body_a, impact.pair->body_b}) {
         if (!moves(body)) continue;
@@ -68,7 +69,7 @@ void WorldImpl::ResolveImpacts(const StepContext& step, const std::vector<Impact
         root_collides[root] |= impact.colliding && round < kMaxImpactRounds;
       }
     }
-    std::vector<std::uint32_t> island_size(bodies_.size(), 0);
+    std::vector<std::uint32_t> island_size(world_.bodies_.size(), 0);
     for (const std::uint32_t body : moving) {
       if (moves(body)) ++island_size[sets.Find(body)];
     }
@@ -76,7 +77,7 @@ void WorldImpl::ResolveImpacts(const StepContext& step, const std::vector<Impact
       const std::uint32_t root = moves(body) ? sets.Find(body) : body;
       if (island_size[root] > kMaxSubStepBodies) root_collides[root] = 0;
     }
-    std::vector<int> island_of_root(bodies_.size(), -1);
+    std::vector<int> island_of_root(world_.bodies_.size(), -1);
     for (const std::uint32_t body : moving) {
       if (!moves(body)) continue;
       const std::uint32_t root = sets.Find(body);
@@ -98,12 +99,12 @@ void WorldImpl::ResolveImpacts(const StepContext& step, const std::vector<Impact
     const double rest = step.dt - island_times[k];
     if (rest > 0.0) SubStep(islands[k], step.Interval(rest), round + 1);
   }
-  moving_bodies_ = moving;
+  world_.moving_bodies_ = moving;
 }
 
 // The body where its path puts it at time t, with the velocity it had then.
-void WorldImpl::BackUpBody(std::uint32_t index, double time) {
-  Body& body = bodies_[index];
+void ExactSolver::BackUpBody(std::uint32_t index, double time) {
+  Body& body = world_.bodies_[index];
   const BodyPath& path = paths_[index];
   const Pose pose = path.At(time);
   body.position = pose.translation;
@@ -118,50 +119,30 @@ void WorldImpl::BackUpBody(std::uint32_t index, double time) {
 // against the rest of the world where it now is: fresh manifolds at the
 // current poses, the contact solve (collisions first), the drift, and the
 // impacts within h.
-void WorldImpl::SubStep(const std::vector<std::uint32_t>& island, const StepContext& step,
-                        int round) {
-  std::vector<char> member(bodies_.size(), 0);
+void ExactSolver::SubStep(const std::vector<std::uint32_t>& island, const StepContext& step,
+                          int round) {
+  std::vector<char> member(world_.bodies_.size(), 0);
   for (const std::uint32_t body : island) member[body] = 1;
   std::vector<ShapePairContact*> pairs;
-  for (ShapePairContact* pair : contact_cache_.seen()) {
+  for (ShapePairContact* pair : world_.contact_cache_.seen()) {
     if (member[pair->body_a] || member[pair->body_b]) pairs.push_back(pair);
   }
   std::vector<ShapePairContact*> touching;
   for (ShapePairContact* pair : pairs) {
-    RecollidePair(step, pair);
+    world_.RecollidePair(step, pair);
     if (pair->manifold.point_count == 0) continue;
-    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0)
+    if (world_.bodies_[pair->body_a].articulation >= 0 ||
+        world_.bodies_[pair->body_b].articulation >= 0)
       continue;
     MatchWarmStarts(pair);
     touching.push_back(pair);
   }
-  moving_bodies_ = island;
+  world_.moving_bodies_ = island;
   SolveTouching(step, touching);
-  ReportContacts(touching, step, /*impacts_only=*/true);
+  world_.ReportContacts(touching, step, /*impacts_only=*/true);
   DriftBodies(step);
   BoundBodyMotion(step);
   ResolveImpacts(step, FindImpacts(step, pairs), touching, round);
-}
-
-// The pair's manifold clipped afresh at the current poses.
-void WorldImpl::RecollidePair(const StepContext& step, ShapePairContact* pair) {
-  const Body& a = bodies_[pair->body_a];
-  const Body& b = bodies_[pair->body_b];
-  const ShapeDef& shape_a = a.shapes[pair->shape_a];
-  const ShapeDef& shape_b = b.shapes[pair->shape_b];
-  CollideInput input;
-  input.a = &shape_a.geometry;
-  input.world_from_a = a.WorldFromBody() * shape_a.body_from_shape;
-  input.b = &shape_b.geometry;
-  input.world_from_b = b.WorldFromBody() * shape_b.body_from_shape;
-  input.contact_distance = ContactDistance(a, b, step);
-  pair->contact_distance = input.contact_distance;
-  CollideStats stats;
-  Collide(input, &pair->witness, &pair->manifold, &stats);
-  pair->apart_gap =
-      pair->manifold.point_count == 0 ? stats.gap : -std::numeric_limits<double>::infinity();
-  pair->apart_travel = a.travel + b.travel;
-  pair->anchors.valid = false;
 }
 
 }  // namespace rigid_body_sim::physics

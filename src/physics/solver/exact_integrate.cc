@@ -1,5 +1,6 @@
-// Stage 5 of WorldImpl::Step: drift the bodies, back up the ones that would
-// enter another body to their time of impact, and put quiet islands to sleep.
+// The exact solver's stage 5: the bodies drift over the step, and a body
+// that would enter another within it is backed up to its time of impact
+// (exact_impacts.cc resolves the impact and simulates the rest of the step).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,7 +10,7 @@
 #include "physics/dynamics/integrator.h"
 #include "physics/dynamics/time_of_impact.h"
 #include "physics/geometry/shape_bounds.h"
-#include "physics/world/union_find.h"
+#include "physics/solver/exact_solver.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
@@ -90,22 +91,23 @@ double ShapeRadius(const ShapeGeometry& geometry) {
 // of its thickness per step is first sampled along its path, so that a thin
 // wall it would pass through entirely still shows a penetrating sample to
 // bracket. Pairs that cannot close their gap within the step are skipped.
-void WorldImpl::IntegrateBodies(const StepContext& step) {
-  articulations_.Move();
+void ExactSolver::IntegrateBodies(const StepContext& step) {
+  world_.articulations_.Move();
   DriftBodies(step);
   BoundBodyMotion(step);
-  ResolveImpacts(step, FindImpacts(step, contact_cache_.seen()), contact_cache_.touching(), 0);
-  UpdateSleep(step);
+  ResolveImpacts(step, FindImpacts(step, world_.contact_cache_.seen()),
+                 world_.contact_cache_.touching(), 0);
+  world_.UpdateSleep(step);
 }
 
 // Scales a moving body's angular momenta (at the start and the end of the
 // step) so that its angular velocity turns it at most max_turn_per_step in
 // dt: |w| <= max_turn / dt with w = I^-1 L. The scale keeps the spin's axis;
 // it only takes energy out, and only from spins no step resolves.
-void WorldImpl::CapSpin(const StepContext& step) {
-  const double max_speed = settings_.max_turn_per_step / step.dt;
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
+void ExactSolver::CapSpin(const StepContext& step) {
+  const double max_speed = world_.settings_.max_turn_per_step / step.dt;
+  for (const std::uint32_t i : world_.moving_bodies_) {
+    Body& body = world_.bodies_[i];
     if (!body.awake || body.disabled) continue;
     const double end_speed = body.angular_velocity.norm();
     const double start_speed = (body.inverse_inertia_world * body.start_angular_momentum).norm();
@@ -121,11 +123,11 @@ void WorldImpl::CapSpin(const StepContext& step) {
 // The awake bodies drift over the step; each one's path (start, end and
 // velocities) is kept for the time-of-impact search. paths_ is kept between
 // steps, so that a step neither allocates nor clears a path per body.
-void WorldImpl::DriftBodies(const StepContext& step) {
+void ExactSolver::DriftBodies(const StepContext& step) {
   CapSpin(step);
-  paths_.resize(bodies_.size());
-  for (const std::uint32_t i : moving_bodies_) {
-    const Body& body = bodies_[i];
+  paths_.resize(world_.bodies_.size());
+  for (const std::uint32_t i : world_.moving_bodies_) {
+    const Body& body = world_.bodies_[i];
     if (!body.awake) continue;
     BodyPath& path = paths_[i];
     path.start = body.WorldFromPrincipal();
@@ -134,15 +136,15 @@ void WorldImpl::DriftBodies(const StepContext& step) {
     path.pseudo_velocity = body.pseudo_linear_velocity;
     path.dt = step.dt;
   }
-  IntegratePositions(step.dt, moving_bodies_, &bodies_);
-  DisableNonFiniteBodies();
-  for (const std::uint32_t i : moving_bodies_) {
-    if (bodies_[i].disabled) paths_[i].dt = 0.0;
+  IntegratePositions(step.dt, world_.moving_bodies_, &world_.bodies_);
+  world_.DisableNonFiniteBodies();
+  for (const std::uint32_t i : world_.moving_bodies_) {
+    if (world_.bodies_[i].disabled) paths_[i].dt = 0.0;
     BodyPath& path = paths_[i];
     if (path.dt == 0.0) continue;
-    path.end = bodies_[i].WorldFromPrincipal();
-    path.turn =
-        TurnBetween(path.start.rotation, path.end.rotation, step.dt * bodies_[i].angular_velocity);
+    path.end = world_.bodies_[i].WorldFromPrincipal();
+    path.turn = TurnBetween(path.start.rotation, path.end.rotation,
+                            step.dt * world_.bodies_[i].angular_velocity);
   }
 }
 
@@ -152,19 +154,19 @@ void WorldImpl::DriftBodies(const StepContext& step) {
 // radius dt max(|v0|, |v1|) (the velocity is linear in t); add the
 // split-impulse drift and the slerp angle times the shapes' reach from the
 // centre.
-void WorldImpl::BoundBodyMotion(const StepContext& step) {
-  for (const std::uint32_t i : moving_bodies_) {
+void ExactSolver::BoundBodyMotion(const StepContext& step) {
+  for (const std::uint32_t i : world_.moving_bodies_) {
     BodyPath& path = paths_[i];
     if (path.dt == 0.0) continue;
     const double angle = path.turn.norm();
-    const double radius = bodies_[i].bounding_radius;
+    const double radius = world_.bodies_[i].bounding_radius;
     const double displacement = (path.end.translation - path.start.translation).norm();
-    path.fast =
-        displacement + angle * radius > settings_.continuous_fraction * bodies_[i].thickness;
+    path.fast = displacement + angle * radius >
+                world_.settings_.continuous_fraction * world_.bodies_[i].thickness;
     path.reach = step.dt * (std::max(path.start_velocity.norm(), path.end_velocity.norm()) +
                             path.pseudo_velocity.norm()) +
                  angle * radius;
-    bodies_[i].travel += path.reach;
+    world_.bodies_[i].travel += path.reach;
   }
 }
 
@@ -174,8 +176,8 @@ void WorldImpl::BoundBodyMotion(const StepContext& step) {
 // Each pair's search reads the bodies and their paths and writes only its
 // own entry, so the pairs are searched on the pool, and the impacts listed
 // afterwards in the pairs' order: the same list for any number of threads.
-std::vector<Impact> WorldImpl::FindImpacts(const StepContext& step,
-                                           const std::vector<ShapePairContact*>& pairs) {
+std::vector<Impact> ExactSolver::FindImpacts(const StepContext& step,
+                                             const std::vector<ShapePairContact*>& pairs) {
   // A pair's search costs 0.1-10 us; a chunk this long amortizes taking it.
   constexpr std::size_t kPairsPerChunk = 64;
   impact_searches_.resize(pairs.size());
@@ -187,7 +189,8 @@ std::vector<Impact> WorldImpl::FindImpacts(const StepContext& step,
     if (paths_[pair->body_a].dt == 0.0 && paths_[pair->body_b].dt == 0.0) return;
     // A link's contacts are the articulation solve's, which lets no point
     // close more than its gap within a step.
-    if (bodies_[pair->body_a].articulation >= 0 || bodies_[pair->body_b].articulation >= 0) {
+    if (world_.bodies_[pair->body_a].articulation >= 0 ||
+        world_.bodies_[pair->body_b].articulation >= 0) {
       return;
     }
     search.time = PairImpactTime(step, pair, &search.approach_speed);
@@ -196,7 +199,8 @@ std::vector<Impact> WorldImpl::FindImpacts(const StepContext& step,
   for (std::size_t e = 0; e < pairs.size(); ++e) {
     const ImpactSearch& search = impact_searches_[e];
     if (!std::isfinite(search.time)) continue;
-    const bool colliding = search.approach_speed > settings_.solver.collision_velocity_threshold;
+    const bool colliding =
+        search.approach_speed > world_.settings_.solver.collision_velocity_threshold;
     impacts.push_back(Impact{pairs[e], search.time, colliding});
   }
   return impacts;
@@ -206,9 +210,9 @@ std::vector<Impact> WorldImpl::FindImpacts(const StepContext& step,
 // manifold, or, with no point, at least the distance the narrow phase
 // looked within, and at least the narrow phase's separating-axis gap less
 // what the bodies travelled between that test and the start of this step.
-double WorldImpl::PairStartGap(const ShapePairContact& pair) const {
-  const double travel_since = bodies_[pair.body_a].travel - paths_[pair.body_a].reach +
-                              bodies_[pair.body_b].travel - paths_[pair.body_b].reach -
+double ExactSolver::PairStartGap(const ShapePairContact& pair) const {
+  const double travel_since = world_.bodies_[pair.body_a].travel - paths_[pair.body_a].reach +
+                              world_.bodies_[pair.body_b].travel - paths_[pair.body_b].reach -
                               pair.apart_travel;
   double start_gap = std::max(pair.contact_distance, pair.apart_gap - travel_since);
   for (int i = 0; i < pair.manifold.point_count; ++i) {
@@ -219,11 +223,11 @@ double WorldImpl::PairStartGap(const ShapePairContact& pair) const {
 
 // The time within the step at which the pair comes within the touching band,
 // or +infinity when it does not or is already in contact.
-double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair,
-                                 double* approach_speed) {
+double ExactSolver::PairImpactTime(const StepContext& step, ShapePairContact* pair,
+                                   double* approach_speed) {
   constexpr double kNoImpact = std::numeric_limits<double>::infinity();
   *approach_speed = 0.0;
-  double touching = settings_.solver.contact_tolerance;
+  double touching = world_.settings_.solver.contact_tolerance;
   // The search stops within 5 % of the touching band above the surface, so
   // the speed at the impact is free fall's to g (0.05 epsilon) / v^2:
   // 2.6e-7 of it after a 1 m drop.
@@ -233,7 +237,8 @@ double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair
   const double start_gap = PairStartGap(*pair);
   const bool fast = path_a.fast || path_b.fast;
   if (start_gap <= touching && !fast) return kNoImpact;
-  if (bodies_[pair->body_a].disabled || bodies_[pair->body_b].disabled) return kNoImpact;
+  if (world_.bodies_[pair->body_a].disabled || world_.bodies_[pair->body_b].disabled)
+    return kNoImpact;
   if (start_gap <= touching) {
     // Already in contact, and fast (a small body spinning on a corner): the
     // solver holds the points it touches at, and the search only keeps
@@ -242,7 +247,7 @@ double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair
     // freeze the body in place with its velocity. The depth allowed is the
     // motion per sample of a fast body, so nothing thicker than four times
     // it can be passed through.
-    const double depth = settings_.continuous_fraction * PairThickness(*pair);
+    const double depth = world_.settings_.continuous_fraction * PairThickness(*pair);
     touching = start_gap - 0.5 * depth;
     target_gap = start_gap - depth;
   }
@@ -252,14 +257,14 @@ double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair
   if (start_gap - pair->reuse_error - reach > target_gap) return kNoImpact;
   if (start_gap <= target_gap) return kNoImpact;  // already in contact: the solver's business
   const PairSweep sweep{&paths_[pair->body_a],
-                        &bodies_[pair->body_a],
+                        &world_.bodies_[pair->body_a],
                         &paths_[pair->body_b],
-                        &bodies_[pair->body_b],
+                        &world_.bodies_[pair->body_b],
                         pair->shape_a,
                         pair->shape_b,
-                        std::max(start_gap, 0.0) + reach + settings_.contact_margin,
-                        ShapeRadius(bodies_[pair->body_a].shapes[pair->shape_a].geometry),
-                        ShapeRadius(bodies_[pair->body_b].shapes[pair->shape_b].geometry)};
+                        std::max(start_gap, 0.0) + reach + world_.settings_.contact_margin,
+                        ShapeRadius(world_.bodies_[pair->body_a].shapes[pair->shape_a].geometry),
+                        ShapeRadius(world_.bodies_[pair->body_b].shapes[pair->shape_b].geometry)};
   // Most pairs that get here end the step still apart, such as boxes side
   // by side with a gap below their manifold's reuse error. Asking only
   // whether they are apart by more than target_gap at the end lets the
@@ -300,145 +305,27 @@ double WorldImpl::PairImpactTime(const StepContext& step, ShapePairContact* pair
 
 // m; the thinner moving body of the pair (a static one never moves through
 // anything).
-double WorldImpl::PairThickness(const ShapePairContact& pair) const {
+double ExactSolver::PairThickness(const ShapePairContact& pair) const {
   double thickness = std::numeric_limits<double>::infinity();
   for (const std::uint32_t index : {pair.body_a, pair.body_b}) {
-    if (paths_[index].dt > 0.0) thickness = std::min(thickness, bodies_[index].thickness);
+    if (paths_[index].dt > 0.0) thickness = std::min(thickness, world_.bodies_[index].thickness);
   }
   return thickness;
 }
 
 // Samples along the faster body's path, so that no sample moves it more than
 // continuous_fraction of its thickness.
-int WorldImpl::PathSamples(std::uint32_t body_a, std::uint32_t body_b) const {
+int ExactSolver::PathSamples(std::uint32_t body_a, std::uint32_t body_b) const {
   double motion = 0.0;
   for (const std::uint32_t index : {body_a, body_b}) {
     const BodyPath& path = paths_[index];
     if (path.dt == 0.0) continue;
     const double displacement = (path.end.translation - path.start.translation).norm() +
-                                path.turn.norm() * bodies_[index].bounding_radius;
-    motion =
-        std::max(motion, displacement / (settings_.continuous_fraction * bodies_[index].thickness));
+                                path.turn.norm() * world_.bodies_[index].bounding_radius;
+    motion = std::max(motion, displacement / (world_.settings_.continuous_fraction *
+                                              world_.bodies_[index].thickness));
   }
   return static_cast<int>(std::clamp(std::ceil(motion), 1.0, kMaxPathSamples));
-}
-
-// Only moving bodies change state within a step, so only they are checked.
-void WorldImpl::DisableNonFiniteBodies() {
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
-    // Its cached pairs are no longer seen from the next step on, and go.
-    DisableBody(i);
-  }
-}
-
-// Out of the simulation until it is given a finite state: asleep, out of
-// the broad phase, and reported once in non_finite_bodies_.
-void WorldImpl::DisableBody(std::uint32_t index) {
-  Body& body = bodies_[index];
-  body.disabled = true;
-  body.awake = false;
-  woke_since_prune_ = true;
-  if (body.has_proxy) {
-    broad_phase_.RemoveProxy(static_cast<int>(index));
-    body.has_proxy = false;
-  }
-  const BodyId id{index, body.generation};
-  if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
-      non_finite_bodies_.end()) {
-    non_finite_bodies_.push_back(id);
-  }
-}
-
-// Whether a body has kept speeding up for sleep.speeding_up_time. Slow is
-// not at rest: a box on a slope 0.2 degrees steeper than its friction angle
-// accelerates at 0.04 m/s^2 and stays below 0.05 m/s for 1.3 s, long enough
-// to fall asleep mid-slide. A settling body's speed rises and falls from
-// step to step; one getting under way gains speed at every step. Speeds
-// below 2 % of the sleep thresholds are noise: the residual velocities of a
-// stack at rest can grow steadily without going anywhere, and counted, they
-// kept the benchmark's pyramids awake.
-bool WorldImpl::UpdateSpeedingUp(const StepContext& step, Body* body) const {
-  constexpr double kNoiseFraction = 0.02;
-  const SleepSettings& sleep = settings_.sleep;
-  const double speed = body->linear_velocity.norm();
-  const double angular_speed = body->angular_velocity.norm();
-  const bool gaining =
-      (speed > body->last_speed && speed > kNoiseFraction * sleep.linear_velocity) ||
-      (angular_speed > body->last_angular_speed &&
-       angular_speed > kNoiseFraction * sleep.angular_velocity);
-  body->last_speed = speed;
-  body->last_angular_speed = angular_speed;
-  body->speeding_up_time = gaining ? body->speeding_up_time + step.dt : 0.0;
-  return sleep.speeding_up_time > 0.0 && body->speeding_up_time >= sleep.speeding_up_time;
-}
-
-// Islands are the connected components of the contact graph through moving
-// bodies (union-find). An island sleeps when every body in it has been slower
-// than the thresholds, or has kept within its sleep window, and not speeding
-// up, for time_to_sleep; it costs nothing until woken.
-void WorldImpl::UpdateSleep(const StepContext& step) {
-  const SleepSettings& sleep = settings_.sleep;
-  if (!sleep.enabled) return;
-  // The islands' scratch keeps its memory from step to step.
-  UnionFind& islands = sleep_scratch_.islands;
-  islands.Reset(bodies_.size());
-  for (const ShapePairContact* pair : contact_cache_.touching()) {
-    const Body& a = bodies_[pair->body_a];
-    const Body& b = bodies_[pair->body_b];
-    if (a.is_static || b.is_static) continue;
-    islands.Join(pair->body_a, pair->body_b);
-  }
-  // Articulations never sleep, nor does what touches them.
-  std::vector<char>& island_has_link = sleep_scratch_.island_has_link;
-  island_has_link.assign(bodies_.size(), 0);
-  for (const ShapePairContact* pair : articulations_.link_pairs()) {
-    for (const std::uint32_t index : {pair->body_a, pair->body_b}) {
-      if (bodies_[index].articulation >= 0) island_has_link[islands.Find(index)] = 1;
-    }
-  }
-  std::vector<double>& island_sleep_time = sleep_scratch_.island_sleep_time;
-  island_sleep_time.assign(bodies_.size(), std::numeric_limits<double>::infinity());
-  sleep_windows_.resize(bodies_.size());
-  const SleepWindowLimits limits =
-      MakeSleepWindowLimits(sleep.linear_velocity, sleep.angular_velocity, sleep.time_to_sleep);
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
-    if (!body.awake) continue;
-    const bool speeding_up = UpdateSpeedingUp(step, &body);
-    if (island_has_link[islands.Find(i)]) {
-      // Held by, resting on or pushed by a link: its quiet time starts
-      // over, so that once the link lets go it must be quiet for
-      // time_to_sleep again; counted on, a box held still for a second fell
-      // asleep in mid-air the step the gripper opened.
-      body.sleep_time = 0.0;
-      RestartSleepWindow(i);
-      island_sleep_time[islands.Find(i)] = 0.0;
-      continue;
-    }
-    const bool slow =
-        !speeding_up &&
-        body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
-        body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
-    body.sleep_time = slow ? body.sleep_time + step.dt : 0.0;
-    // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
-    if (speeding_up) RestartSleepWindow(i);
-    const double still_time =
-        UpdateSleepWindow(body.WorldFromPrincipal(), limits, step.dt, &sleep_windows_[i]);
-    const double quiet_time = std::max(body.sleep_time, still_time);
-    double& island = island_sleep_time[islands.Find(i)];
-    island = std::min(island, quiet_time);
-  }
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
-    if (!body.awake) continue;
-    if (island_sleep_time[islands.Find(i)] < sleep.time_to_sleep) continue;
-    body.awake = false;
-    body.linear_momentum.setZero();
-    body.angular_momentum.setZero();
-    body.UpdateDerived();
-  }
 }
 
 }  // namespace rigid_body_sim::physics

@@ -1,0 +1,131 @@
+// Stage 5's end, for both solvers: bodies whose state is not finite are
+// disabled, and quiet islands are put to sleep.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "physics/dynamics/integrator.h"
+#include "physics/world/union_find.h"
+#include "physics/world/world_impl.h"
+
+namespace rigid_body_sim::physics {
+
+// Only moving bodies change state within a step, so only they are checked.
+void WorldImpl::DisableNonFiniteBodies() {
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
+    // Its cached pairs are no longer seen from the next step on, and go.
+    DisableBody(i);
+  }
+}
+
+// Out of the simulation until it is given a finite state: asleep, out of
+// the broad phase, and reported once in non_finite_bodies_.
+void WorldImpl::DisableBody(std::uint32_t index) {
+  Body& body = bodies_[index];
+  body.disabled = true;
+  body.awake = false;
+  woke_since_prune_ = true;
+  if (body.has_proxy) {
+    broad_phase_.RemoveProxy(static_cast<int>(index));
+    body.has_proxy = false;
+  }
+  const BodyId id{index, body.generation};
+  if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
+      non_finite_bodies_.end()) {
+    non_finite_bodies_.push_back(id);
+  }
+}
+
+// Whether a body has kept speeding up for sleep.speeding_up_time. Slow is
+// not at rest: a box on a slope 0.2 degrees steeper than its friction angle
+// accelerates at 0.04 m/s^2 and stays below 0.05 m/s for 1.3 s, long enough
+// to fall asleep mid-slide. A settling body's speed rises and falls from
+// step to step; one getting under way gains speed at every step. Speeds
+// below 2 % of the sleep thresholds are noise: the residual velocities of a
+// stack at rest can grow steadily without going anywhere, and counted, they
+// kept the benchmark's pyramids awake.
+bool WorldImpl::UpdateSpeedingUp(const StepContext& step, Body* body) const {
+  constexpr double kNoiseFraction = 0.02;
+  const SleepSettings& sleep = settings_.sleep;
+  const double speed = body->linear_velocity.norm();
+  const double angular_speed = body->angular_velocity.norm();
+  const bool gaining =
+      (speed > body->last_speed && speed > kNoiseFraction * sleep.linear_velocity) ||
+      (angular_speed > body->last_angular_speed &&
+       angular_speed > kNoiseFraction * sleep.angular_velocity);
+  body->last_speed = speed;
+  body->last_angular_speed = angular_speed;
+  body->speeding_up_time = gaining ? body->speeding_up_time + step.dt : 0.0;
+  return sleep.speeding_up_time > 0.0 && body->speeding_up_time >= sleep.speeding_up_time;
+}
+
+// Islands are the connected components of the contact graph through moving
+// bodies (union-find). An island sleeps when every body in it has been slower
+// than the thresholds, or has kept within its sleep window, and not speeding
+// up, for time_to_sleep; it costs nothing until woken.
+void WorldImpl::UpdateSleep(const StepContext& step) {
+  const SleepSettings& sleep = settings_.sleep;
+  if (!sleep.enabled) return;
+  // The islands' scratch keeps its memory from step to step.
+  UnionFind& islands = sleep_scratch_.islands;
+  islands.Reset(bodies_.size());
+  for (const ShapePairContact* pair : contact_cache_.touching()) {
+    const Body& a = bodies_[pair->body_a];
+    const Body& b = bodies_[pair->body_b];
+    if (a.is_static || b.is_static) continue;
+    islands.Join(pair->body_a, pair->body_b);
+  }
+  // Articulations never sleep, nor does what touches them.
+  std::vector<char>& island_has_link = sleep_scratch_.island_has_link;
+  island_has_link.assign(bodies_.size(), 0);
+  for (const ShapePairContact* pair : articulations_.link_pairs()) {
+    for (const std::uint32_t index : {pair->body_a, pair->body_b}) {
+      if (bodies_[index].articulation >= 0) island_has_link[islands.Find(index)] = 1;
+    }
+  }
+  std::vector<double>& island_sleep_time = sleep_scratch_.island_sleep_time;
+  island_sleep_time.assign(bodies_.size(), std::numeric_limits<double>::infinity());
+  sleep_windows_.resize(bodies_.size());
+  const SleepWindowLimits limits =
+      MakeSleepWindowLimits(sleep.linear_velocity, sleep.angular_velocity, sleep.time_to_sleep);
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.awake) continue;
+    const bool speeding_up = UpdateSpeedingUp(step, &body);
+    if (island_has_link[islands.Find(i)]) {
+      // Held by, resting on or pushed by a link: its quiet time starts
+      // over, so that once the link lets go it must be quiet for
+      // time_to_sleep again; counted on, a box held still for a second fell
+      // asleep in mid-air the step the gripper opened.
+      body.sleep_time = 0.0;
+      RestartSleepWindow(i);
+      island_sleep_time[islands.Find(i)] = 0.0;
+      continue;
+    }
+    const bool slow =
+        !speeding_up &&
+        body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
+        body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
+    body.sleep_time = slow ? body.sleep_time + step.dt : 0.0;
+    // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
+    if (speeding_up) RestartSleepWindow(i);
+    const double still_time =
+        UpdateSleepWindow(body.WorldFromPrincipal(), limits, step.dt, &sleep_windows_[i]);
+    const double quiet_time = std::max(body.sleep_time, still_time);
+    double& island = island_sleep_time[islands.Find(i)];
+    island = std::min(island, quiet_time);
+  }
+  for (const std::uint32_t i : moving_bodies_) {
+    Body& body = bodies_[i];
+    if (!body.awake) continue;
+    if (island_sleep_time[islands.Find(i)] < sleep.time_to_sleep) continue;
+    body.awake = false;
+    body.linear_momentum.setZero();
+    body.angular_momentum.setZero();
+    body.UpdateDerived();
+  }
+}
+
+}  // namespace rigid_body_sim::physics
