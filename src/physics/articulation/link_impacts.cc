@@ -203,13 +203,7 @@ double ArticulationSystem::LinkPairImpactTime(const StepContext& step,
     input.world_from_b = BodyPoseOnImpactPath(pair.body_b, slot_of_articulation, t) *
                          b.shapes[pair.shape_b].body_from_shape;
     input.contact_distance = cap;
-    ContactManifold manifold;
-    double gap = cap;
-    if (Collide(input, nullptr, &manifold)) {
-      for (int i = 0; i < manifold.point_count; ++i)
-        gap = std::min(gap, manifold.points[i].separation);
-    }
-    return gap;
+    return Gap(input);
   };
   ImpactBracket bracket{0.0, gap_at(0.0), -1.0, 0.0};
   if (!(bracket.gap_low > 0.0)) return 0.0;

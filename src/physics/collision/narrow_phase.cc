@@ -283,4 +283,14 @@ bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManif
   return true;
 }
 
+double Gap(const CollideInput& input) {
+  ContactManifold manifold;
+  double gap = input.contact_distance;
+  if (Collide(input, nullptr, &manifold)) {
+    for (int i = 0; i < manifold.point_count; ++i)
+      gap = std::min(gap, manifold.points[i].separation);
+  }
+  return gap;
+}
+
 }  // namespace rigid_body_sim::physics

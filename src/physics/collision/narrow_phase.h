@@ -29,6 +29,11 @@ struct CollideInput {
 bool Collide(const CollideInput& input, SeparatingWitness* witness, ContactManifold* manifold,
              CollideStats* stats = nullptr);
 
+// The shapes' gap, m: the least separation of their manifold's points, or
+// contact_distance when they are apart by at least that much (what the
+// time-of-impact searches bracket).
+double Gap(const CollideInput& input);
+
 }  // namespace rigid_body_sim::physics
 
 #endif  // RIGID_BODY_SIM_PHYSICS_COLLISION_NARROW_PHASE_H_

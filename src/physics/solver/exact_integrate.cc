@@ -62,16 +62,7 @@ struct PairSweep {
     return (a_world - b_world).norm() - radius_a - radius_b;
   }
   // The gap at time t: the nearest manifold point, at most gap_cap.
-  double GapAt(double t) const {
-    ContactManifold manifold;
-    double gap = gap_cap;
-    if (Collide(InputAt(t, gap_cap), nullptr, &manifold)) {
-      for (int i = 0; i < manifold.point_count; ++i) {
-        gap = std::min(gap, manifold.points[i].separation);
-      }
-    }
-    return gap;
-  }
+  double GapAt(double t) const { return Gap(InputAt(t, gap_cap)); }
 };
 
 // m; the radius of a sphere about the shape's origin that holds it.
