@@ -1,8 +1,11 @@
 #include "physics/articulation/articulation_solver.h"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
+
+#include "physics/contact/contact_frame.h"
 
 namespace rigid_body_sim::physics {
 
@@ -173,14 +176,11 @@ double ArticulationSolver::UpdateFriction(std::size_t k, double* speed) {
   ConstraintRow& t0 = rows_[k];
   ConstraintRow& t1 = rows_[k + 1];
   const double limit = t0.friction * rows_[t0.normal_row].impulse;
-  double l0 = t0.impulse - t0.inverse_mass * RowVelocity(t0);
-  double l1 = t1.impulse - t1.inverse_mass * RowVelocity(t1);
-  const double norm = std::hypot(l0, l1);
-  if (norm > limit) {
-    const double scale = norm > 0.0 ? limit / norm : 0.0;
-    l0 *= scale;
-    l1 *= scale;
-  }
+  std::array<double, 2> l = {t0.impulse - t0.inverse_mass * RowVelocity(t0),
+                             t1.impulse - t1.inverse_mass * RowVelocity(t1)};
+  ClampToDisc(limit, &l);
+  const double l0 = l[0];
+  const double l1 = l[1];
   const double change0 = l0 - t0.impulse;
   const double change1 = l1 - t1.impulse;
   t0.impulse = l0;

@@ -1,9 +1,11 @@
 // What every contact row shares, a body's or a link's: the tangent basis of
-// its normal and the combined material of its two shapes.
+// its normal, the combined material of its two shapes, and the friction
+// disc its tangential impulse is projected onto.
 #ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_FRAME_H_
 #define RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_FRAME_H_
 
 #include <array>
+#include <cmath>
 
 #include "rigid_body_sim/physics/types.h"
 
@@ -16,6 +18,20 @@ std::array<Vec3, 2> TangentBasis(const Vec3& normal);
 // Combination rules: e = max(ea, eb), mu = sqrt(mu_a mu_b).
 double CombineRestitution(double restitution_a, double restitution_b);
 double CombineFriction(double friction_a, double friction_b);
+
+// Projects the tangential impulse onto the disc |t| <= limit (a circular
+// friction cone, so there is no directional bias).
+inline void ClampToDisc(double limit, std::array<double, 2>* tangent) {
+  // sqrt of the sum of squares: hypot's care for overflow costs more than
+  // the whole row update, and impulses are nowhere near 1e150.
+  const double norm_squared = (*tangent)[0] * (*tangent)[0] + (*tangent)[1] * (*tangent)[1];
+  if (norm_squared > limit * limit) {
+    const double norm = std::sqrt(norm_squared);
+    const double scale = norm > 0.0 ? limit / norm : 0.0;
+    (*tangent)[0] *= scale;
+    (*tangent)[1] *= scale;
+  }
+}
 
 }  // namespace rigid_body_sim::physics
 

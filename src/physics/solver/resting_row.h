@@ -9,23 +9,10 @@
 #include <cmath>
 #include <vector>
 
+#include "physics/contact/contact_frame.h"
 #include "physics/solver/contact_solver.h"
 
 namespace rigid_body_sim::physics {
-
-// Projects the tangential impulse onto the disc |t| <= limit (a circular
-// friction cone, so there is no directional bias).
-inline void ClampToDisc(double limit, std::array<double, 2>* tangent) {
-  // sqrt of the sum of squares: hypot's care for overflow costs more than
-  // the whole row update, and impulses are nowhere near 1e150.
-  const double norm_squared = (*tangent)[0] * (*tangent)[0] + (*tangent)[1] * (*tangent)[1];
-  if (norm_squared > limit * limit) {
-    const double norm = std::sqrt(norm_squared);
-    const double scale = norm > 0.0 ? limit / norm : 0.0;
-    (*tangent)[0] *= scale;
-    (*tangent)[1] *= scale;
-  }
-}
 
 // The velocities of the two bodies of one run of rows, held in locals while
 // the run's rows update them, so that one row's result reaches the next in
