@@ -176,7 +176,8 @@ Pose ArticulationSystem::BodyPoseOnImpactPath(std::uint32_t index,
 
 // The time a link pair first touches on its articulations' paths through
 // the step, q(t) = q + t u-, or +infinity when no sample of the path
-// touches (a graze that the linear estimate s / (-J u-) still times).
+// touches (a graze) or the shapes touch already at its start; the linear
+// estimate s / (-J u-) times those.
 // The joints move on a straight line in q, but a link's points on arcs,
 // so the gap is the shapes' own (the narrow phase at q(t)), not the row's
 // linear J q: at 100 m/s on a 1 m arm, the linear time put the rebound
@@ -206,7 +207,9 @@ double ArticulationSystem::LinkPairImpactTime(const StepContext& step,
     return Gap(input);
   };
   ImpactBracket bracket{0.0, gap_at(0.0), -1.0, 0.0};
-  if (!(bracket.gap_low > 0.0)) return 0.0;
+  // A reused manifold may call apart shapes that touch by its reuse error:
+  // no bracket starts there, and the linear estimate stands.
+  if (!(bracket.gap_low > 0.0)) return std::numeric_limits<double>::infinity();
   double thickness = std::numeric_limits<double>::infinity();
   for (const Body* body : {&a, &b}) {
     if (body->articulation >= 0) thickness = std::min(thickness, body->thickness);
