@@ -28,7 +28,7 @@ namespace {
 // up to this many bodies (a part a gripper presses on a table, a stack a
 // foot stands on). A larger one keeps the rigid solver for its own
 // contacts: with 16 or 64 here, an arm pushing through a lattice of 100
-// boxes (arm_push_100) took 1.4 times its step's time, with 4 0.96
+// boxes (arm_push_100) took 1.4 times its step's time, and with 4, 0.94
 // (docs/performance.md, "One contact problem for an island with a link").
 constexpr std::uint32_t kMostLinkIslandBodies = 4;
 // rad or m: how near its limit a joint keeps its limit row.
@@ -228,25 +228,26 @@ void ArticulationSystem::TakeLinkPairs(const std::vector<ShapePairContact*>& tou
   // one of them touches a link.
   std::vector<std::uint32_t>& size = island_sizes_;
   size.assign(bodies_.size(), 0);
-  std::vector<char>& counted = island_touches_link_;
-  counted.assign(bodies_.size(), 0);
+  // Bit 0 of a body: counted; bit 1 of a root: its island touches a link.
+  std::vector<char>& flags = island_flags_;
+  flags.assign(bodies_.size(), 0);
   for (const ShapePairContact* pair : touching) {
     for (const std::uint32_t body : {pair->body_a, pair->body_b}) {
-      if (!moves(body) || (counted[body] & 1) != 0) continue;
-      counted[body] |= 1;
+      if (!moves(body) || (flags[body] & 1) != 0) continue;
+      flags[body] |= 1;
       ++size[islands.Find(body)];
     }
   }
   for (const ShapePairContact* pair : touching) {
     if (!has_link(*pair)) continue;
     for (const std::uint32_t body : {pair->body_a, pair->body_b}) {
-      if (moves(body)) counted[islands.Find(body)] |= 2;
+      if (moves(body)) flags[islands.Find(body)] |= 2;
     }
   }
   const auto in_link_island = [&](std::uint32_t body) {
     if (!moves(body)) return false;
     const std::uint32_t root = islands.Find(body);
-    return (counted[root] & 2) != 0 && size[root] <= kMostLinkIslandBodies;
+    return (flags[root] & 2) != 0 && size[root] <= kMostLinkIslandBodies;
   };
   for (ShapePairContact* pair : touching) {
     const bool link =

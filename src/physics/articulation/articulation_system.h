@@ -178,9 +178,9 @@ class ArticulationSystem {
   Eigen::VectorXd acceleration_scratch_;
   std::vector<ShapePairContact*> link_pairs_;  // TakeLinkPairs'
   UnionFind link_islands_;                     // TakeLinkPairs' scratch
-  // TakeLinkPairs' scratch, per body: bit 0 counted, bit 1 (of a root)
-  // its island touches a link; and per root its size.
-  std::vector<char> island_touches_link_;
+  // TakeLinkPairs' scratch: per body slot, its flags (counted; of a root,
+  // the island touches a link), and per island root its size.
+  std::vector<char> island_flags_;
   std::vector<std::uint32_t> island_sizes_;
   // Per link pair, the index of its first normal row, or -1.
   std::vector<int> link_pair_rows_;
