@@ -209,46 +209,78 @@ int ArticulationSolver::Solve(const SweepLimits& limits) {
     if (row.kind == RowKind::kNormal) row.impulse = std::max(row.impulse, 0.0);
     if (row.impulse != 0.0) ApplyImpulse(row, row.impulse);
   }
+  // The rows a sweep updates, a tangent pair by its first row.
+  std::vector<std::size_t>& swept = swept_scratch_;
+  swept.clear();
+  for (std::size_t k = 0; k < rows_.size(); k += rows_[k].kind == RowKind::kTangent ? 2 : 1) {
+    swept.push_back(k);
+  }
   const bool by_speed = limits.contact_speed > 0.0;
-  const auto rigid = [](const ConstraintRow& row) {
-    return row.a.kind != RowSide::Kind::kArticulation && row.b.kind != RowSide::Kind::kArticulation;
-  };
+  double held_scale = 0.0;  // N s, the largest impulse of the rows held
   int sweep = 0;
   while (sweep < limits.max_sweeps) {
     ++sweep;
-    const bool sweep_rigid = sweep <= limits.rigid_sweeps;
-    double largest = 0.0;
-    double scale = 0.0;
-    double fastest = 0.0;  // m/s, of the contact rows judged by speed
-    for (std::size_t k = 0; k < rows_.size(); ++k) {
-      ConstraintRow& row = rows_[k];
-      const bool held = !sweep_rigid && rigid(row);
-      // A tangent row is always taken with its pair, even one that moves
-      // nothing (a cart on a rail across it): skipping it alone would take
-      // its pair for the first of a pair, and the row after for its pair.
-      if (row.kind == RowKind::kTangent) {
-        double speed = 0.0;
-        const double change = held ? 0.0 : UpdateFriction(k, by_speed ? &speed : nullptr);
-        if (by_speed) {
-          fastest = std::max(fastest, speed);
-        } else {
-          largest = std::max(largest, change);
-        }
-        ++k;  // its pair was updated with it
-        continue;
-      }
-      const double change = held ? 0.0 : UpdateRow(&row);
-      if (by_speed && row.joint < 0) {
-        if (row.inverse_mass > 0.0) fastest = std::max(fastest, change / row.inverse_mass);
-      } else {
-        largest = std::max(largest, change);
-      }
-      scale = std::max(scale, std::abs(row.impulse));
-    }
-    if (largest <= limits.tolerance * std::max(scale, 1e-12) && fastest <= limits.contact_speed)
+    if (sweep - 1 == limits.rigid_sweeps) held_scale = HoldRigidRows(&swept);
+    const SweepChange change = Sweep(swept, by_speed);
+    const double scale = std::max(change.scale, held_scale);
+    if (change.largest <= limits.tolerance * std::max(scale, 1e-12) &&
+        change.fastest <= limits.contact_speed)
       break;
   }
   return sweep;
+}
+
+// Drops the rows between rigid bodies alone from `swept`; their impulses
+// stay as they are, so the largest of them still sets the sweeps' scale,
+// which is returned.
+double ArticulationSolver::HoldRigidRows(std::vector<std::size_t>* swept) const {
+  double held_scale = 0.0;
+  std::size_t kept = 0;
+  for (const std::size_t k : *swept) {
+    const ConstraintRow& row = rows_[k];
+    const bool rigid =
+        row.a.kind != RowSide::Kind::kArticulation && row.b.kind != RowSide::Kind::kArticulation;
+    if (!rigid) {
+      (*swept)[kept++] = k;
+    } else if (row.kind != RowKind::kTangent) {
+      held_scale = std::max(held_scale, std::abs(row.impulse));
+    }
+  }
+  swept->resize(kept);
+  return held_scale;
+}
+
+// One projected Gauss-Seidel sweep over `swept` (Cottle, Pang and Stone
+// 1992, section 5.2): the largest change of an impulse, the largest velocity
+// a contact row's change makes (when judged `by_speed`) and the largest
+// impulse of a normal or bounded row.
+ArticulationSolver::SweepChange ArticulationSolver::Sweep(const std::vector<std::size_t>& swept,
+                                                          bool by_speed) {
+  SweepChange result;
+  for (const std::size_t k : swept) {
+    ConstraintRow& row = rows_[k];
+    // A tangent row is always taken with its pair, even one that moves
+    // nothing (a cart on a rail across it).
+    if (row.kind == RowKind::kTangent) {
+      double speed = 0.0;
+      const double change = UpdateFriction(k, by_speed ? &speed : nullptr);
+      if (by_speed) {
+        result.fastest = std::max(result.fastest, speed);
+      } else {
+        result.largest = std::max(result.largest, change);
+      }
+      continue;
+    }
+    const double change = UpdateRow(&row);
+    if (by_speed && row.joint < 0) {
+      if (row.inverse_mass > 0.0)
+        result.fastest = std::max(result.fastest, change / row.inverse_mass);
+    } else {
+      result.largest = std::max(result.largest, change);
+    }
+    result.scale = std::max(result.scale, std::abs(row.impulse));
+  }
+  return result;
 }
 
 // lambda <- proj(lambda - (v - target + gamma lambda) / (J M^-1 J^T + gamma)),

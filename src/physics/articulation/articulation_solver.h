@@ -158,11 +158,19 @@ class ArticulationSolver {
   // The same for a point's two friction rows together; `speed` gets the
   // larger of the velocities their changes make.
   double UpdateFriction(std::size_t k, double* speed = nullptr);
+  struct SweepChange {
+    double largest = 0.0;  // N s, the largest change of an impulse judged by size
+    double fastest = 0.0;  // m/s, the largest velocity change of a row judged by speed
+    double scale = 0.0;    // N s, the largest normal or bounded impulse
+  };
+  SweepChange Sweep(const std::vector<std::size_t>& swept, bool by_speed);
+  double HoldRigidRows(std::vector<std::size_t>* swept) const;
 
   std::vector<ArticulationSlot> articulations_;
   std::vector<BodySlot> bodies_;
   std::vector<int> slot_of_body_;
   std::vector<ConstraintRow> rows_;
+  std::vector<std::size_t> swept_scratch_;  // Solve's rows
 };
 
 }  // namespace rigid_body_sim::physics
