@@ -123,10 +123,13 @@ int ArticulationSolver::AddRow(ConstraintRow row) {
   return static_cast<int>(rows_.size()) - 1;
 }
 
-double ArticulationSolver::SideVelocity(const RowSide& side) const {
+// A side's velocity and the impulse's effect on it: the rigid body's
+// branch inlined into the sweeps' row updates, an articulation's (a dot over
+// its joints) called.
+[[gnu::always_inline]] inline double ArticulationSolver::SideVelocity(const RowSide& side) const {
   switch (side.kind) {
     case RowSide::Kind::kArticulation:
-      return side.jacobian.head(side.extent).dot(articulations_[side.slot].u.head(side.extent));
+      return ArticulationVelocity(side);
     case RowSide::Kind::kBody: {
       const BodySlot& body = bodies_[side.slot];
       return side.linear.dot(body.linear_velocity) + side.angular.dot(body.angular_velocity);
@@ -135,6 +138,10 @@ double ArticulationSolver::SideVelocity(const RowSide& side) const {
       break;
   }
   return 0.0;
+}
+
+[[gnu::noinline]] double ArticulationSolver::ArticulationVelocity(const RowSide& side) const {
+  return side.jacobian.head(side.extent).dot(articulations_[side.slot].u.head(side.extent));
 }
 
 double ArticulationSolver::SideResponse(const RowSide& side) const {
@@ -153,10 +160,11 @@ double ArticulationSolver::RowVelocity(const ConstraintRow& row) const {
   return SideVelocity(row.a) + SideVelocity(row.b);
 }
 
-void ArticulationSolver::ApplyImpulse(const ConstraintRow& row, double impulse) {
+[[gnu::always_inline]] inline void ArticulationSolver::ApplyImpulse(const ConstraintRow& row,
+                                                                    double impulse) {
   for (const RowSide* side : {&row.a, &row.b}) {
     if (side->kind == RowSide::Kind::kArticulation) {
-      articulations_[side->slot].u += impulse * side->response;
+      ApplyToArticulation(*side, impulse);
     } else if (side->kind == RowSide::Kind::kBody) {
       BodySlot& body = bodies_[side->slot];
       // As in ContactSolver::ApplyImpulse: a body that does not move keeps
@@ -166,6 +174,11 @@ void ArticulationSolver::ApplyImpulse(const ConstraintRow& row, double impulse) 
       body.angular_velocity += impulse * side->angular_response;
     }
   }
+}
+
+[[gnu::noinline]] void ArticulationSolver::ApplyToArticulation(const RowSide& side,
+                                                               double impulse) {
+  articulations_[side.slot].u += impulse * side.response;
 }
 
 // The two friction rows of a point together: each moves toward zero

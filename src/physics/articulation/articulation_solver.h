@@ -152,6 +152,8 @@ class ArticulationSolver {
   double SideVelocity(const RowSide& side) const;
   double SideResponse(const RowSide& side) const;  // J M^-1 J^T of the side
   void ApplyImpulse(const ConstraintRow& row, double impulse);
+  double ArticulationVelocity(const RowSide& side) const;
+  void ApplyToArticulation(const RowSide& side, double impulse);
   // One projected Gauss-Seidel update of a normal or bounded row; returns
   // |change of its impulse|.
   double UpdateRow(ConstraintRow* row);
