@@ -5,6 +5,8 @@
 // threads_test's).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -12,6 +14,7 @@
 
 #include "physics/scene.h"
 #include "physics/solver/constraint_colouring.h"
+#include "physics/solver/support_balance.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -191,6 +194,86 @@ TEST(SoftStepTest, PyramidStands) {
   const double drift = (world.GetBody(top).position - start).norm();
   std::printf("pyramid of %d rows: top drift %.6f m\n", kRows, drift);
   EXPECT_LT(drift, 1e-3);
+}
+
+// A pyramid spawned touching, kept awake: each box rests on two, and the
+// end boxes of each row carry one box above on one half, so their loads
+// sit off their centres. Seeded with equal loads per point, a box tilted
+// on its springs until they balanced that moment: the top of 10 rows sank
+// 0.11 mm in 0.3 s (pyramid_40 0.84 mm, pyramid_90 3 mm). Seeded with
+// loads balanced in moment, nothing moves.
+TEST(SoftStepTest, PyramidSpawnedTouchingHoldsItsTopWhileAwake) {
+  WorldSettings settings = SoftSettings();
+  settings.sleep.time_to_sleep = 100.0;
+  World world(settings);
+  AddGround(&world, MakeMaterial(0.6, 0.0));
+  constexpr int kRows = 10;
+  BodyId top;
+  for (int row = 0; row < kRows; ++row) {
+    for (int i = 0; i < kRows - row; ++i) {
+      BoxSpec spec;
+      spec.material = MakeMaterial(0.6, 0.0);
+      spec.world_from_body = Translation(i - 0.5 * (kRows - row - 1), 0.0, 0.5 + row);
+      top = AddBox(&world, spec);
+    }
+  }
+  const Vec3 start = world.GetBody(top).position;
+  double largest = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    StepFor(&world, 0.25);
+    ASSERT_TRUE(world.GetBody(top).awake);
+    largest = std::max(largest, (world.GetBody(top).position - start).norm());
+  }
+  std::printf("pyramid of %d rows, awake 2 s: top moved at most %.3g m\n", kRows, largest);
+  EXPECT_LT(largest, 1e-6);
+}
+
+// A 1 kg box whose support on a 2 kg box is offset: the points' loads are
+// those of a rigid body on equal springs, lambda_i = L/N + L e.d_i / sum d^2
+// along x, so each body's supports carry its load with no moment about it.
+TEST(SoftStepTest, NewSupportsCarryTheirLoadWithNoMoment) {
+  std::vector<Body> bodies(3);
+  bodies[0].is_static = true;
+  bodies[1].mass = 2.0;
+  bodies[1].position = Vec3(0.0, 0.0, 0.1);
+  bodies[2].mass = 1.0;
+  bodies[2].position = Vec3(0.05, 0.0, 0.3);
+  std::vector<ShapePairContact> pairs(2);
+  std::vector<ShapePairContact*> pair_pointers = {&pairs[0], &pairs[1]};
+  // Manifold 0: the lower box on the ground, its corners x, y = +-0.1.
+  // Manifold 1: the upper box on the lower one, over x in [-0.05, 0.1].
+  std::vector<SolverManifold> manifolds(2);
+  const std::array<double, 4> xs0 = {-0.1, 0.1, 0.1, -0.1};
+  const std::array<double, 4> xs1 = {-0.05, 0.1, 0.1, -0.05};
+  const std::array<double, 4> ys = {-0.1, -0.1, 0.1, 0.1};
+  for (int m = 0; m < 2; ++m) {
+    manifolds[m].body_a = m == 0 ? 1 : 2;
+    manifolds[m].body_b = m == 0 ? 0 : 1;
+    manifolds[m].point_count = 4;
+    for (int i = 0; i < 4; ++i) {
+      const Vec3 at((m == 0 ? xs0 : xs1)[i], ys[i], m == 0 ? 0.0 : 0.2);
+      manifolds[m].points[i].r_a = at - bodies[manifolds[m].body_a].position;
+      manifolds[m].points[i].normal_impulse = 1.0;  // replaced
+    }
+  }
+  SupportBalanceInput input;
+  input.bodies = &bodies;
+  input.pairs = &pair_pointers;
+  input.gravity = Vec3(0.0, 0.0, -9.81);
+  input.dt = 0.01;
+  input.contact_tolerance = 1e-4;
+  BalanceNewSupports(input, &manifolds);
+  const double unit = 9.81 * 0.01;  // N s, 1 kg's weight over the step
+  // Upper box: L = 1, points at x - 0.025 = -+0.075, e = 0.025.
+  // Lower box: L = 3, load centre (0.1 * 2/3 - 0.05 * 1/3) / 3 = 1/60,
+  // points at x = +-0.1.
+  for (int i = 0; i < 4; ++i) {
+    const double d1 = xs1[i] - 0.025;
+    EXPECT_NEAR(manifolds[1].points[i].normal_impulse,
+                unit * (0.25 + 0.025 * d1 / (4 * 0.075 * 0.075)), 1e-12);
+    EXPECT_NEAR(manifolds[0].points[i].normal_impulse,
+                unit * (0.75 + 3.0 / 60.0 * xs0[i] / (4 * 0.01)), 1e-12);
+  }
 }
 
 // An island asleep is left alone: its pose does not change by a bit, and

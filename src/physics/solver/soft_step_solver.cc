@@ -9,6 +9,7 @@
 #include "physics/dynamics/integrator.h"
 #include "physics/solver/motion_solver.h"
 #include "physics/solver/soft_contact_solver.h"
+#include "physics/solver/support_balance.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
@@ -80,6 +81,13 @@ void SoftStepSolver::SeedNewSupports(const StepContext& step) {
   WorldImpl& w = world_;
   w.SeedNewSupportLoads(w.rigid_pairs_, step);
   std::vector<SolverManifold>& manifolds = w.solver_.manifolds();
+  SupportBalanceInput balance;
+  balance.bodies = &w.bodies_;
+  balance.pairs = &w.rigid_pairs_;
+  balance.gravity = w.settings_.gravity;
+  balance.dt = step.dt;
+  balance.contact_tolerance = w.settings_.solver.contact_tolerance;
+  BalanceNewSupports(balance, &manifolds);
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     if (w.rigid_pairs_[m]->previous_count != 0) continue;
     for (int i = 0; i < manifolds[m].point_count; ++i) {

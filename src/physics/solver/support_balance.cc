@@ -1,0 +1,161 @@
+#include "physics/solver/support_balance.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace rigid_body_sim::physics {
+
+namespace {
+
+// A support seen from the body it holds up: manifold m, with n.up of its
+// normal oriented upward.
+struct Support {
+  std::uint32_t manifold;
+  std::uint32_t upper;
+  std::uint32_t lower;
+  bool is_new;
+  double up_along_normal;  // > kUpright
+};
+
+// A support is upright when its normal is within 60 degrees of up, as in
+// WorldImpl::SeedNewSupportLoads.
+constexpr double kUpright = 0.5;
+
+std::vector<Support> UprightSupports(const SupportBalanceInput& input, const Vec3& up,
+                                     const std::vector<SolverManifold>& manifolds) {
+  std::vector<Support> supports;
+  for (std::uint32_t m = 0; m < manifolds.size(); ++m) {
+    const SolverManifold& manifold = manifolds[m];
+    const double up_along_normal = manifold.normal_world.dot(up);  // the normal points to A
+    if (std::abs(up_along_normal) <= kUpright || manifold.point_count == 0) continue;
+    bool is_new = (*input.pairs)[m]->previous_count == 0;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      is_new &= manifold.points[i].separation <= input.contact_tolerance;
+    }
+    if (up_along_normal > 0.0) {
+      supports.push_back({m, manifold.body_a, manifold.body_b, is_new, up_along_normal});
+    } else {
+      supports.push_back({m, manifold.body_b, manifold.body_a, is_new, -up_along_normal});
+    }
+  }
+  return supports;
+}
+
+// A point of a support, in world space, with its vertical load (N s).
+struct LoadPoint {
+  std::uint32_t support;
+  int point;
+  Vec3 position;
+  double load;
+};
+
+// lambda_i = L / N + d_i . C^+ (L e) over the points still carrying; a
+// point that would pull (lambda_i < 0, the load's line outside the middle of
+// the support) is dropped and the rest solved again, as an active set
+// method for the loads' least squares under lambda >= 0 would (Lawson and
+// Hanson 1974, "Solving Least Squares Problems", chapter 23). What is left
+// after kMostDrops rounds is clamped and scaled back to L.
+void Spread(double total, const Vec3& load_centre, const Vec3& up, std::vector<LoadPoint>* points) {
+  constexpr int kMostDrops = 4;
+  const auto horizontal = [&](const Vec3& v) { return Vec3(v - v.dot(up) * up); };
+  std::vector<char> carries(points->size(), 1);
+  for (int round = 0; round <= kMostDrops; ++round) {
+    Vec3 centroid = Vec3::Zero();
+    int count = 0;
+    for (std::size_t i = 0; i < points->size(); ++i) {
+      if (carries[i] == 0) continue;
+      centroid += (*points)[i].position;
+      ++count;
+    }
+    centroid /= count;
+    Mat3 spread = Mat3::Zero();
+    for (std::size_t i = 0; i < points->size(); ++i) {
+      const Vec3 d = horizontal((*points)[i].position - centroid);
+      if (carries[i] != 0) spread += d * d.transpose();
+    }
+    const Vec3 beta = spread.completeOrthogonalDecomposition().solve(
+        Vec3(total * horizontal(load_centre - centroid)));
+    bool dropped = false;
+    for (std::size_t i = 0; i < points->size(); ++i) {
+      LoadPoint& p = (*points)[i];
+      p.load = carries[i] == 0 ? 0.0 : total / count + horizontal(p.position - centroid).dot(beta);
+      if (p.load < 0.0 && round < kMostDrops && count > 1) {
+        carries[i] = 0;
+        dropped = true;
+      }
+    }
+    if (!dropped) break;
+  }
+  double sum = 0.0;
+  for (LoadPoint& p : *points) {
+    p.load = std::max(p.load, 0.0);
+    sum += p.load;
+  }
+  if (sum <= 0.0) return;
+  for (LoadPoint& p : *points) p.load *= total / sum;
+}
+
+}  // namespace
+
+void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverManifold>* manifolds) {
+  const std::vector<Body>& bodies = *input.bodies;
+  const double g = input.gravity.norm();
+  if (g <= 0.0) return;
+  const Vec3 up = -input.gravity / g;
+  std::vector<Support> supports = UprightSupports(input, up, *manifolds);
+  if (std::none_of(supports.begin(), supports.end(), [](const Support& s) { return s.is_new; }))
+    return;
+  const auto height = [&](std::uint32_t body) { return bodies[body].position.dot(up); };
+  std::sort(supports.begin(), supports.end(), [&](const Support& x, const Support& y) {
+    const double hx = height(x.upper);
+    const double hy = height(y.upper);
+    return hx != hy ? hx > hy : x.upper < y.upper;
+  });
+  const auto carries_load = [&](std::uint32_t body) {
+    const Body& b = bodies[body];
+    return !b.is_static && b.awake && !b.disabled;
+  };
+  // Per body: its vertical load (N s) and that load's moment, sum F x.
+  std::vector<double> load(bodies.size(), 0.0);
+  std::vector<Vec3> moment(bodies.size(), Vec3::Zero());
+  for (const Support& s : supports) {
+    load[s.upper] = bodies[s.upper].mass * g * input.dt;
+    moment[s.upper] = load[s.upper] * bodies[s.upper].position;
+  }
+  std::vector<LoadPoint> points;
+  for (std::size_t first = 0; first < supports.size();) {
+    const std::uint32_t upper = supports[first].upper;
+    std::size_t last = first;
+    bool all_new = true;
+    points.clear();
+    for (; last < supports.size() && supports[last].upper == upper; ++last) {
+      const Support& s = supports[last];
+      all_new &= s.is_new;
+      const SolverManifold& manifold = (*manifolds)[s.manifold];
+      const Vec3& centre = bodies[manifold.body_a].position;
+      for (int i = 0; i < manifold.point_count; ++i) {
+        const SolverPoint& point = manifold.points[i];
+        points.push_back({static_cast<std::uint32_t>(last), i, Vec3(centre + point.r_a),
+                          point.normal_impulse * s.up_along_normal});
+      }
+    }
+    if (all_new && carries_load(upper) && load[upper] > 0.0) {
+      Spread(load[upper], moment[upper] / load[upper], up, &points);
+      for (const LoadPoint& p : points) {
+        const Support& s = supports[p.support];
+        (*manifolds)[s.manifold].points[p.point].normal_impulse = p.load / s.up_along_normal;
+      }
+    }
+    for (const LoadPoint& p : points) {
+      const std::uint32_t lower = supports[p.support].lower;
+      if (!carries_load(lower)) continue;
+      load[lower] += p.load;
+      moment[lower] += p.load * p.position;
+    }
+    first = last;
+  }
+}
+
+}  // namespace rigid_body_sim::physics

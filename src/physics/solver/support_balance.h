@@ -1,0 +1,43 @@
+// The soft step's seeds for supports that are new this step, balanced in
+// moment as well as in force (docs/design.md, "The soft step").
+#ifndef RIGID_BODY_SIM_PHYSICS_SOLVER_SUPPORT_BALANCE_H_
+#define RIGID_BODY_SIM_PHYSICS_SOLVER_SUPPORT_BALANCE_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "physics/contact/contact_cache.h"
+#include "physics/solver/contact_solver.h"
+#include "rigid_body_sim/physics/body.h"
+#include "rigid_body_sim/physics/types.h"
+
+namespace rigid_body_sim::physics {
+
+struct SupportBalanceInput {
+  const std::vector<Body>* bodies = nullptr;
+  // One per manifold: the pair it was built from (for previous_count).
+  const std::vector<ShapePairContact*>* pairs = nullptr;
+  Vec3 gravity = Vec3::Zero();     // m/s^2
+  double dt = 0.0;                 // s
+  double contact_tolerance = 0.0;  // m: a point this close touches
+};
+
+// Spreads each body's seeded load over the points of its supports so that
+// the points carry its weight and the loads it bears from above with no net
+// moment about the vertical, as equal springs under a rigid body would
+// (the least-squares spread; Timoshenko and Goodier 1951, "Theory of
+// Elasticity", section 7, a rigid punch on springs): with N points at
+// horizontal offsets d_i from their centroid, a total load L whose line of
+// action passes at offset e from it,
+//   lambda_i = L / N + d_i . C^+ (L e),  C = sum d_i d_i^T,
+// a point that would pull (lambda_i < 0) dropped and the rest solved again
+// (support_balance.cc). Only a body whose upright
+// supports are all new is spread (the others carry their cached loads);
+// bodies are visited from the highest down, so each body's loads from above
+// are known when it is spread. Writes the points' normal_impulse (N s per
+// step).
+void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverManifold>* manifolds);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_SOLVER_SUPPORT_BALANCE_H_
