@@ -23,19 +23,17 @@ struct SupportBalanceInput {
 };
 
 // Spreads each body's seeded load over the points of its supports so that
-// the points carry its weight and the loads it bears from above with no net
-// moment about the vertical, as equal springs under a rigid body would
-// (the least-squares spread; Timoshenko and Goodier 1951, "Theory of
-// Elasticity", section 7, a rigid punch on springs): with N points at
-// horizontal offsets d_i from their centroid, a total load L whose line of
-// action passes at offset e from it,
-//   lambda_i = L / N + d_i . C^+ (L e),  C = sum d_i d_i^T,
-// a point that would pull (lambda_i < 0) dropped and the rest solved again
-// (support_balance.cc). Only a body whose upright
-// supports are all new is spread (the others carry their cached loads);
-// bodies are visited from the highest down, so each body's loads from above
-// are known when it is spread. Writes the points' normal_impulse (N s per
-// step).
+// they carry its weight and the loads it bears from above with no net
+// moment about the vertical, as equal springs under a rigid body would: the
+// least sum lambda_i^2 with sum lambda_i = L and sum lambda_i d_i = L e (N
+// points at horizontal offsets d_i from their centroid, the load's line of
+// action at offset e), whose Lagrange conditions make lambda_i affine in d_i:
+//   lambda_i = L / N + d_i . C^+ (L e),  C = sum d_i d_i^T.
+// A point that would pull (lambda_i < 0) is dropped and the rest solved
+// again (support_balance.cc). Only a body whose upright supports are all
+// new is spread (the others keep their cached loads); bodies are visited
+// from the highest down, so each body's loads from above are known when it
+// is spread. Writes the points' normal_impulse (N s per step).
 void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverManifold>* manifolds);
 
 }  // namespace rigid_body_sim::physics
