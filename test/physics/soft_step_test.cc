@@ -44,6 +44,23 @@ BoxSpec RestingBox(double mass = 1.0) {
   return spec;
 }
 
+// A pyramid of unit boxes (mu = 0.6, e = 0) on the ground, spawned
+// touching: row r has `rows` - r boxes, each on two of the row below.
+// Returns the top box.
+BodyId AddPyramid(World* world, int rows) {
+  AddGround(world, MakeMaterial(0.6, 0.0));
+  BodyId top;
+  for (int row = 0; row < rows; ++row) {
+    for (int i = 0; i < rows - row; ++i) {
+      BoxSpec spec;
+      spec.material = MakeMaterial(0.6, 0.0);
+      spec.world_from_body = Translation(i - 0.5 * (rows - row - 1), 0.0, 0.5 + row);
+      top = AddBox(world, spec);
+    }
+  }
+  return top;
+}
+
 void StepFor(World* world, double seconds) {
   const int steps = static_cast<int>(std::lround(seconds / world->settings().time_step));
   for (int i = 0; i < steps; ++i) world->Step();
@@ -178,17 +195,8 @@ TEST(SoftStepTest, BulletDoesNotPassAThinWall) {
 // 1 mm of where it was spawned.
 TEST(SoftStepTest, PyramidStands) {
   World world(SoftSettings());
-  AddGround(&world, MakeMaterial(0.6, 0.0));
   constexpr int kRows = 10;
-  BodyId top;
-  for (int row = 0; row < kRows; ++row) {
-    for (int i = 0; i < kRows - row; ++i) {
-      BoxSpec spec;
-      spec.material = MakeMaterial(0.6, 0.0);
-      spec.world_from_body = Translation(i - 0.5 * (kRows - row - 1), 0.0, 0.5 + row);
-      top = AddBox(&world, spec);
-    }
-  }
+  const BodyId top = AddPyramid(&world, kRows);
   const Vec3 start = world.GetBody(top).position;
   StepFor(&world, 3.0);
   const double drift = (world.GetBody(top).position - start).norm();
@@ -206,17 +214,8 @@ TEST(SoftStepTest, PyramidSpawnedTouchingHoldsItsTopWhileAwake) {
   WorldSettings settings = SoftSettings();
   settings.sleep.time_to_sleep = 100.0;
   World world(settings);
-  AddGround(&world, MakeMaterial(0.6, 0.0));
   constexpr int kRows = 10;
-  BodyId top;
-  for (int row = 0; row < kRows; ++row) {
-    for (int i = 0; i < kRows - row; ++i) {
-      BoxSpec spec;
-      spec.material = MakeMaterial(0.6, 0.0);
-      spec.world_from_body = Translation(i - 0.5 * (kRows - row - 1), 0.0, 0.5 + row);
-      top = AddBox(&world, spec);
-    }
-  }
+  const BodyId top = AddPyramid(&world, kRows);
   const Vec3 start = world.GetBody(top).position;
   double largest = 0.0;
   for (int k = 0; k < 8; ++k) {

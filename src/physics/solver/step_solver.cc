@@ -6,6 +6,7 @@
 
 #include "physics/collision/mesh_collision.h"
 #include "physics/dynamics/integrator.h"
+#include "physics/solver/support_balance.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
@@ -62,43 +63,15 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
                                     const StepContext& step) {
   const double g = settings_.gravity.norm();
   if (g <= 0.0) return;
-  const Vec3 up = -settings_.gravity / g;
-  // A support is upright when its normal is within 60 degrees of up.
-  constexpr double kUpright = 0.5;
-  struct Support {
-    std::uint32_t manifold;
-    std::uint32_t upper;
-    std::uint32_t lower;
-    bool is_new;
-    double up_along_normal;  // n.up, > kUpright
-  };
-  std::vector<Support> supports;
-  bool any_new = false;
+  SupportBalanceInput input;
+  input.bodies = &bodies_;
+  input.pairs = &pairs;
+  input.gravity = settings_.gravity;
+  input.dt = step.dt;
+  input.contact_tolerance = settings_.solver.contact_tolerance;
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  for (std::uint32_t m = 0; m < manifolds.size(); ++m) {
-    const SolverManifold& manifold = manifolds[m];
-    const double up_along_normal = manifold.normal_world.dot(up);  // the normal points to A
-    if (std::abs(up_along_normal) <= kUpright || manifold.point_count == 0) continue;
-    bool is_new = pairs[m]->previous_count == 0;
-    for (int i = 0; i < manifold.point_count; ++i) {
-      is_new &= manifold.points[i].separation <= settings_.solver.contact_tolerance;
-    }
-    any_new |= is_new;
-    if (up_along_normal > 0.0) {
-      supports.push_back({m, manifold.body_a, manifold.body_b, is_new, up_along_normal});
-    } else {
-      supports.push_back({m, manifold.body_b, manifold.body_a, is_new, -up_along_normal});
-    }
-  }
-  if (!any_new) return;
-  // Highest upper body first, so that a body's load is complete before it
-  // is passed on; ties by index, for the same result on every run.
-  auto height = [&](std::uint32_t body) { return bodies_[body].position.dot(up); };
-  std::sort(supports.begin(), supports.end(), [&](const Support& x, const Support& y) {
-    const double hx = height(x.upper);
-    const double hy = height(y.upper);
-    return hx != hy ? hx > hy : x.upper < y.upper;
-  });
+  const std::vector<UprightSupport> supports = UprightSupportsHighestFirst(input, manifolds);
+  if (supports.empty()) return;
   auto carries_load = [&](std::uint32_t body) {
     const Body& b = bodies_[body];
     return !b.is_static && b.awake && !b.disabled;
@@ -107,11 +80,11 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
   // supports share.
   std::vector<double> load(bodies_.size(), 0.0);
   std::vector<int> new_supports(bodies_.size(), 0);
-  for (const Support& support : supports) {
+  for (const UprightSupport& support : supports) {
     load[support.upper] = bodies_[support.upper].mass * g * step.dt;
     if (support.is_new) ++new_supports[support.upper];
   }
-  auto warm_load = [&](const Support& support) {
+  auto warm_load = [&](const UprightSupport& support) {
     const SolverManifold& manifold = manifolds[support.manifold];
     double normal = 0.0;
     for (int i = 0; i < manifold.point_count; ++i) normal += manifold.points[i].normal_impulse;
@@ -125,7 +98,7 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
       }
       load[upper] = std::max(load[upper], 0.0);
     }
-    const Support& support = supports[k];
+    const UprightSupport& support = supports[k];
     double passed = 0.0;
     if (!support.is_new) {
       passed = warm_load(support);

@@ -9,40 +9,6 @@ namespace rigid_body_sim::physics {
 
 namespace {
 
-// A support seen from the body it holds up: manifold m, with n.up of its
-// normal oriented upward.
-struct Support {
-  std::uint32_t manifold;
-  std::uint32_t upper;
-  std::uint32_t lower;
-  bool is_new;
-  double up_along_normal;  // > kUpright
-};
-
-// A support is upright when its normal is within 60 degrees of up, as in
-// WorldImpl::SeedNewSupportLoads.
-constexpr double kUpright = 0.5;
-
-std::vector<Support> UprightSupports(const SupportBalanceInput& input, const Vec3& up,
-                                     const std::vector<SolverManifold>& manifolds) {
-  std::vector<Support> supports;
-  for (std::uint32_t m = 0; m < manifolds.size(); ++m) {
-    const SolverManifold& manifold = manifolds[m];
-    const double up_along_normal = manifold.normal_world.dot(up);  // the normal points to A
-    if (std::abs(up_along_normal) <= kUpright || manifold.point_count == 0) continue;
-    bool is_new = (*input.pairs)[m]->previous_count == 0;
-    for (int i = 0; i < manifold.point_count; ++i) {
-      is_new &= manifold.points[i].separation <= input.contact_tolerance;
-    }
-    if (up_along_normal > 0.0) {
-      supports.push_back({m, manifold.body_a, manifold.body_b, is_new, up_along_normal});
-    } else {
-      supports.push_back({m, manifold.body_b, manifold.body_a, is_new, -up_along_normal});
-    }
-  }
-  return supports;
-}
-
 // A point of a support, in world space, with its vertical load (N s).
 struct LoadPoint {
   std::uint32_t support;
@@ -99,20 +65,53 @@ void Spread(double total, const Vec3& load_centre, const Vec3& up, std::vector<L
 
 }  // namespace
 
+std::vector<UprightSupport> UprightSupportsHighestFirst(
+    const SupportBalanceInput& input, const std::vector<SolverManifold>& manifolds) {
+  std::vector<UprightSupport> supports;
+  const double g = input.gravity.norm();
+  if (g <= 0.0) return supports;
+  const Vec3 up = -input.gravity / g;
+  // A support is upright when its normal is within 60 degrees of up.
+  constexpr double kUpright = 0.5;
+  bool any_new = false;
+  for (std::uint32_t m = 0; m < manifolds.size(); ++m) {
+    const SolverManifold& manifold = manifolds[m];
+    const double up_along_normal = manifold.normal_world.dot(up);  // the normal points to A
+    if (std::abs(up_along_normal) <= kUpright || manifold.point_count == 0) continue;
+    bool is_new = (*input.pairs)[m]->previous_count == 0;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      is_new &= manifold.points[i].separation <= input.contact_tolerance;
+    }
+    any_new |= is_new;
+    if (up_along_normal > 0.0) {
+      supports.push_back({m, manifold.body_a, manifold.body_b, is_new, up_along_normal});
+    } else {
+      supports.push_back({m, manifold.body_b, manifold.body_a, is_new, -up_along_normal});
+    }
+  }
+  if (!any_new) {
+    supports.clear();
+    return supports;
+  }
+  // Ties by index, for the same order on every run.
+  const std::vector<Body>& bodies = *input.bodies;
+  const auto height = [&](std::uint32_t body) { return bodies[body].position.dot(up); };
+  std::sort(supports.begin(), supports.end(),
+            [&](const UprightSupport& x, const UprightSupport& y) {
+              const double hx = height(x.upper);
+              const double hy = height(y.upper);
+              return hx != hy ? hx > hy : x.upper < y.upper;
+            });
+  return supports;
+}
+
 void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverManifold>* manifolds) {
   const std::vector<Body>& bodies = *input.bodies;
   const double g = input.gravity.norm();
   if (g <= 0.0) return;
   const Vec3 up = -input.gravity / g;
-  std::vector<Support> supports = UprightSupports(input, up, *manifolds);
-  if (std::none_of(supports.begin(), supports.end(), [](const Support& s) { return s.is_new; }))
-    return;
-  const auto height = [&](std::uint32_t body) { return bodies[body].position.dot(up); };
-  std::sort(supports.begin(), supports.end(), [&](const Support& x, const Support& y) {
-    const double hx = height(x.upper);
-    const double hy = height(y.upper);
-    return hx != hy ? hx > hy : x.upper < y.upper;
-  });
+  const std::vector<UprightSupport> supports = UprightSupportsHighestFirst(input, *manifolds);
+  if (supports.empty()) return;
   const auto carries_load = [&](std::uint32_t body) {
     const Body& b = bodies[body];
     return !b.is_static && b.awake && !b.disabled;
@@ -120,7 +119,7 @@ void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverMani
   // Per body: its vertical load (N s) and that load's moment, sum F x.
   std::vector<double> load(bodies.size(), 0.0);
   std::vector<Vec3> moment(bodies.size(), Vec3::Zero());
-  for (const Support& s : supports) {
+  for (const UprightSupport& s : supports) {
     load[s.upper] = bodies[s.upper].mass * g * input.dt;
     moment[s.upper] = load[s.upper] * bodies[s.upper].position;
   }
@@ -131,7 +130,7 @@ void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverMani
     bool all_new = true;
     points.clear();
     for (; last < supports.size() && supports[last].upper == upper; ++last) {
-      const Support& s = supports[last];
+      const UprightSupport& s = supports[last];
       all_new &= s.is_new;
       const SolverManifold& manifold = (*manifolds)[s.manifold];
       const Vec3& centre = bodies[manifold.body_a].position;
@@ -144,7 +143,7 @@ void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverMani
     if (all_new && carries_load(upper) && load[upper] > 0.0) {
       Spread(load[upper], moment[upper] / load[upper], up, &points);
       for (const LoadPoint& p : points) {
-        const Support& s = supports[p.support];
+        const UprightSupport& s = supports[p.support];
         (*manifolds)[s.manifold].points[p.point].normal_impulse = p.load / s.up_along_normal;
       }
     }

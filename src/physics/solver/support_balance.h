@@ -1,5 +1,7 @@
-// The soft step's seeds for supports that are new this step, balanced in
-// moment as well as in force (docs/design.md, "The soft step").
+// The seeds of supports that are new this step: the upright supports from
+// the highest body down, which both solvers' seeds walk, and the soft step's
+// spread of each body's load, balanced in moment as well as in force
+// (docs/design.md, "The soft step").
 #ifndef RIGID_BODY_SIM_PHYSICS_SOLVER_SUPPORT_BALANCE_H_
 #define RIGID_BODY_SIM_PHYSICS_SOLVER_SUPPORT_BALANCE_H_
 
@@ -21,6 +23,22 @@ struct SupportBalanceInput {
   double dt = 0.0;                 // s
   double contact_tolerance = 0.0;  // m: a point this close touches
 };
+
+// A support seen from the body it holds up: manifold `manifold`, whose
+// normal is within 60 degrees of up, n.up taken upward.
+struct UprightSupport {
+  std::uint32_t manifold;
+  std::uint32_t upper;
+  std::uint32_t lower;
+  bool is_new;  // no point last step, and every point within contact_tolerance
+  double up_along_normal;
+};
+
+// The upright supports, the highest upper body first (ties by index), so
+// that a body's load from above is complete before it is passed on; none
+// when no support is new.
+std::vector<UprightSupport> UprightSupportsHighestFirst(
+    const SupportBalanceInput& input, const std::vector<SolverManifold>& manifolds);
 
 // Spreads each body's seeded load over the points of its supports so that
 // they carry its weight and the loads it bears from above with no net
