@@ -73,10 +73,11 @@ void SoftStepSolver::Solve(const StepContext& step) {
 }
 
 // A new support starts from the load it would carry at rest (the exact
-// solver's estimate, SeedNewSupportLoads), both as its warm start and as its
-// spring's preload: a stack spawned at rest then starts near its
-// equilibrium, instead of sagging on unloaded springs while the load
-// tracking catches up.
+// solver's estimate, SeedNewSupportLoads, spread over the points so that
+// each body carries its load with no moment, BalanceNewSupports), both as
+// its warm start and as its spring's preload: a stack spawned at rest then
+// starts at its equilibrium, instead of sagging on unloaded springs while
+// the load tracking catches up.
 void SoftStepSolver::SeedNewSupports(const StepContext& step) {
   WorldImpl& w = world_;
   w.SeedNewSupportLoads(w.rigid_pairs_, step);
