@@ -261,7 +261,7 @@ TEST(SoftStepTest, NewSupportsCarryTheirLoadWithNoMoment) {
   input.gravity = Vec3(0.0, 0.0, -9.81);
   input.dt = 0.01;
   input.contact_tolerance = 1e-4;
-  BalanceNewSupports(input, &manifolds);
+  BalanceNewSupports(input, UprightSupportsHighestFirst(input, manifolds), &manifolds);
   const double unit = 9.81 * 0.01;  // N s, 1 kg's weight over the step
   // Upper box: L = 1, points at x - 0.025 = -+0.075, e = 0.025.
   // Lower box: L = 3, load centre (0.1 * 2/3 - 0.05 * 1/3) / 3 = 1/60,

@@ -80,15 +80,9 @@ void SoftStepSolver::Solve(const StepContext& step) {
 // the load tracking catches up.
 void SoftStepSolver::SeedNewSupports(const StepContext& step) {
   WorldImpl& w = world_;
-  w.SeedNewSupportLoads(w.rigid_pairs_, step);
+  const std::vector<UprightSupport> supports = w.SeedNewSupportLoads(w.rigid_pairs_, step);
   std::vector<SolverManifold>& manifolds = w.solver_.manifolds();
-  SupportBalanceInput balance;
-  balance.bodies = &w.bodies_;
-  balance.pairs = &w.rigid_pairs_;
-  balance.gravity = w.settings_.gravity;
-  balance.dt = step.dt;
-  balance.contact_tolerance = w.settings_.solver.contact_tolerance;
-  BalanceNewSupports(balance, &manifolds);
+  BalanceNewSupports(w.SupportInput(w.rigid_pairs_, step), supports, &manifolds);
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     if (w.rigid_pairs_[m]->previous_count != 0) continue;
     for (int i = 0; i < manifolds[m].point_count; ++i) {

@@ -58,24 +58,17 @@ ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
 // load up a stack by about one level per sweep, so a stack spawned at rest
 // sags and rocks for its first tenth of a second. The estimate is only
 // where the iteration starts: the complementarity conditions, and so the
-// solution, are the same.
-void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
-                                    const StepContext& step) {
+// solution, are the same. Returns the upright supports it walked (none when
+// no support is new), for the soft step's spread.
+std::vector<UprightSupport> WorldImpl::SeedNewSupportLoads(
+    const std::vector<ShapePairContact*>& pairs, const StepContext& step) {
   const double g = settings_.gravity.norm();
-  if (g <= 0.0) return;
-  SupportBalanceInput input;
-  input.bodies = &bodies_;
-  input.pairs = &pairs;
-  input.gravity = settings_.gravity;
-  input.dt = step.dt;
-  input.contact_tolerance = settings_.solver.contact_tolerance;
+  if (g <= 0.0) return {};
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  const std::vector<UprightSupport> supports = UprightSupportsHighestFirst(input, manifolds);
-  if (supports.empty()) return;
-  auto carries_load = [&](std::uint32_t body) {
-    const Body& b = bodies_[body];
-    return !b.is_static && b.awake && !b.disabled;
-  };
+  std::vector<UprightSupport> supports =
+      UprightSupportsHighestFirst(SupportInput(pairs, step), manifolds);
+  if (supports.empty()) return supports;
+  auto carries_load = [&](std::uint32_t body) { return CarriesLoad(bodies_[body]); };
   // N s: a body's load; then, from its first support on, what its new
   // supports share.
   std::vector<double> load(bodies_.size(), 0.0);
@@ -110,6 +103,18 @@ void WorldImpl::SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
     }
     if (carries_load(support.lower)) load[support.lower] += passed;
   }
+  return supports;
+}
+
+SupportBalanceInput WorldImpl::SupportInput(const std::vector<ShapePairContact*>& pairs,
+                                            const StepContext& step) const {
+  SupportBalanceInput input;
+  input.bodies = &bodies_;
+  input.pairs = &pairs;
+  input.gravity = settings_.gravity;
+  input.dt = step.dt;
+  input.contact_tolerance = settings_.solver.contact_tolerance;
+  return input;
 }
 
 // The bodies that move this step; the stages from here on visit only them,

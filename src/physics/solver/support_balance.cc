@@ -105,17 +105,13 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
   return supports;
 }
 
-void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverManifold>* manifolds) {
+void BalanceNewSupports(const SupportBalanceInput& input,
+                        const std::vector<UprightSupport>& supports,
+                        std::vector<SolverManifold>* manifolds) {
   const std::vector<Body>& bodies = *input.bodies;
   const double g = input.gravity.norm();
-  if (g <= 0.0) return;
+  if (g <= 0.0 || supports.empty()) return;
   const Vec3 up = -input.gravity / g;
-  const std::vector<UprightSupport> supports = UprightSupportsHighestFirst(input, *manifolds);
-  if (supports.empty()) return;
-  const auto carries_load = [&](std::uint32_t body) {
-    const Body& b = bodies[body];
-    return !b.is_static && b.awake && !b.disabled;
-  };
   // Per body: its vertical load (N s) and that load's moment, sum F x.
   std::vector<double> load(bodies.size(), 0.0);
   std::vector<Vec3> moment(bodies.size(), Vec3::Zero());
@@ -140,7 +136,7 @@ void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverMani
                           point.normal_impulse * s.up_along_normal});
       }
     }
-    if (all_new && carries_load(upper) && load[upper] > 0.0) {
+    if (all_new && CarriesLoad(bodies[upper]) && load[upper] > 0.0) {
       Spread(load[upper], moment[upper] / load[upper], up, &points);
       for (const LoadPoint& p : points) {
         const UprightSupport& s = supports[p.support];
@@ -149,7 +145,7 @@ void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverMani
     }
     for (const LoadPoint& p : points) {
       const std::uint32_t lower = supports[p.support].lower;
-      if (!carries_load(lower)) continue;
+      if (!CarriesLoad(bodies[lower])) continue;
       load[lower] += p.load;
       moment[lower] += p.load * p.position;
     }

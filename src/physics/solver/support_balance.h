@@ -34,6 +34,12 @@ struct UprightSupport {
   double up_along_normal;
 };
 
+// Whether a body takes a share of the loads resting on it: a static,
+// sleeping or disabled body passes nothing on, as the solve never moves it.
+inline bool CarriesLoad(const Body& body) {
+  return !body.is_static && body.awake && !body.disabled;
+}
+
 // The upright supports, the highest upper body first (ties by index), so
 // that a body's load from above is complete before it is passed on; none
 // when no support is new.
@@ -51,8 +57,11 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
 // again (support_balance.cc). Only a body whose upright supports are all
 // new is spread (the others keep their cached loads); bodies are visited
 // from the highest down, so each body's loads from above are known when it
-// is spread. Writes the points' normal_impulse (N s per step).
-void BalanceNewSupports(const SupportBalanceInput& input, std::vector<SolverManifold>* manifolds);
+// is spread. `supports` is UprightSupportsHighestFirst's list for these
+// manifolds. Writes the points' normal_impulse (N s per step).
+void BalanceNewSupports(const SupportBalanceInput& input,
+                        const std::vector<UprightSupport>& supports,
+                        std::vector<SolverManifold>* manifolds);
 
 }  // namespace rigid_body_sim::physics
 

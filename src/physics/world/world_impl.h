@@ -18,6 +18,7 @@
 #include "physics/dynamics/sleep_window.h"
 #include "physics/solver/contact_solver.h"
 #include "physics/solver/motion_solver.h"
+#include "physics/solver/support_balance.h"
 #include "physics/world/step_context.h"
 #include "physics/world/task_pool.h"
 #include "physics/world/union_find.h"
@@ -147,7 +148,10 @@ class WorldImpl : public LinkBodies {
   void GuardAfterStep();
   void FreezeBody(std::uint32_t index, const Pose& world_from_principal);
   // `pairs` are the touching pairs, one per solver manifold.
-  void SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
+  std::vector<UprightSupport> SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
+                                                  const StepContext& step);
+  SupportBalanceInput SupportInput(const std::vector<ShapePairContact*>& pairs,
+                                   const StepContext& step) const;
   ContactReport MakeReport(const ShapePairContact& pair, int point,
                            const std::array<Vec3, 2>& tangent,
                            const StepContext& step) const override;
