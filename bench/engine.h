@@ -73,8 +73,9 @@ struct OurSettingsOverrides {
   std::optional<double> velocity_tolerance;  // m/s, the sweeps' early stop, >= 0
   std::optional<bool> interleave_independent_runs;  // the sweeps pair independent runs of rows
   std::optional<bool>
-      batch_independent_runs;  // the sweeps update runs four at a time in SIMD lanes
-  std::optional<int> threads;  // WorldSettings::threads, [0, 256]
+      batch_independent_runs;           // the sweeps update runs four at a time in SIMD lanes
+  std::optional<bool> soft_simd_lanes;  // the soft step updates four contacts at a time
+  std::optional<int> threads;           // WorldSettings::threads, [0, 256]
   std::optional<physics::MotionSolverKind> motion_solver;  // WorldSettings::motion_solver
 };
 

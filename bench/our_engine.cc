@@ -100,6 +100,8 @@ class OurEngine : public Engine {
         overrides.interleave_independent_runs.value_or(solver.interleave_independent_runs);
     solver.batch_independent_runs =
         overrides.batch_independent_runs.value_or(solver.batch_independent_runs);
+    settings.soft_step.simd_lanes =
+        overrides.soft_simd_lanes.value_or(settings.soft_step.simd_lanes);
     settings.sleep.time_to_sleep = overrides.time_to_sleep.value_or(settings.sleep.time_to_sleep);
     settings.threads = overrides.threads.value_or(settings.threads);
     settings.motion_solver = overrides.motion_solver.value_or(settings.motion_solver);

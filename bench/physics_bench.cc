@@ -17,13 +17,14 @@
 //                      [--hull-bench PATH]
 //                      [--velocity-iterations N] [--time-to-sleep S]
 //                      [--velocity-tolerance V] [--interleave-independent-runs 0|1]
-//                      [--batch-independent-runs 0|1] [--hill-amplitude A]
+//                      [--batch-independent-runs 0|1] [--soft-simd-lanes 0|1]
+//                      [--hill-amplitude A]
 //                      [--articulated-rates 240,1000]
 //   --scale S multiplies the simulated time of pile_4000 and pyramid_90,
 //   the two scenes that dominate the run time, and --large-runs N sets
 //   their number of runs. --velocity-iterations, --time-to-sleep (s),
-//   --velocity-tolerance (m/s), --interleave-independent-runs and
-//   --batch-independent-runs run our
+//   --velocity-tolerance (m/s), --interleave-independent-runs,
+//   --batch-independent-runs and --soft-simd-lanes (the soft step's) run our
 //   engine with those solver and sleep settings instead of the defaults, to
 //   measure what a setting costs or buys; the header says so
 //   (--time-to-sleep also reaches bullet_oursleep). --hill-amplitude A (m,
@@ -149,14 +150,17 @@ Options ParseOptions(int argc, char** argv) {
       } else {
         options.hill_amplitude = *amplitude;
       }
-    } else if (key == "--interleave-independent-runs" || key == "--batch-independent-runs") {
+    } else if (key == "--interleave-independent-runs" || key == "--batch-independent-runs" ||
+               key == "--soft-simd-lanes") {
       const std::optional<bool> flag = ParseFlag(value);
       if (!flag) {
         options.error = key + " wants 0 or 1, got " + value;
       } else if (key == "--interleave-independent-runs") {
         options.overrides.interleave_independent_runs = *flag;
-      } else {
+      } else if (key == "--batch-independent-runs") {
         options.overrides.batch_independent_runs = *flag;
+      } else {
+        options.overrides.soft_simd_lanes = *flag;
       }
     } else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
@@ -227,6 +231,10 @@ void PrintHeader(const Options& options, double window_seconds) {
   if (overrides.batch_independent_runs) {
     std::printf("ours: batch_independent_runs = %s\n",
                 *overrides.batch_independent_runs ? "true" : "false");
+  }
+  if (overrides.soft_simd_lanes) {
+    std::printf("ours, soft step: simd_lanes = %s\n",
+                *overrides.soft_simd_lanes ? "true" : "false");
   }
   if (options.hill_amplitude != 0.5) {
     std::printf("terrain_100: hills of %g m instead of 0.5 m\n", options.hill_amplitude);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -242,6 +243,55 @@ TEST(ThreadsTest, TwoThreadsStepLikeTheReferenceEveryStep) {
 
 TEST(ThreadsTest, SoftStepTwoThreadsStepLikeTheReferenceEveryStep) {
   ExpectTwoThreadsStepLikeTheReference(MotionSolverKind::kSoftStep);
+}
+
+// A pyramid of `rows` unit boxes spawned touching, each box on two: every
+// box in contact with up to six, its supports all new at the first step.
+std::vector<BodyId> BuildPyramid(World* world, int rows) {
+  std::vector<BodyId> bodies;
+  AddGround(world, MakeMaterial(0.6, 0.0));
+  for (int row = 0; row < rows; ++row) {
+    for (int i = 0; i < rows - row; ++i) {
+      BoxSpec spec;
+      spec.material = MakeMaterial(0.6, 0.0);
+      spec.world_from_body =
+          Pose{Vec3(i - 0.5 * (rows - row - 1), 0.0, 0.5 + row), Quat::Identity()};
+      bodies.push_back(AddBox(world, spec));
+    }
+  }
+  return bodies;
+}
+
+// Step by step, the soft step with its contacts four at a time in SIMD
+// lanes (SoftStepSettings::simd_lanes) gives every body's state and every
+// contact report of the scalar update, bit for bit.
+void ExpectLanesStepLikeTheScalarUpdate(const std::function<std::vector<BodyId>(World*)>& build,
+                                        int threads, int steps) {
+  WorldSettings scalar_settings = WithThreads(threads, MotionSolverKind::kSoftStep);
+  scalar_settings.soft_step.simd_lanes = false;
+  World scalar(scalar_settings);
+  World lanes(WithThreads(threads, MotionSolverKind::kSoftStep));
+  ASSERT_TRUE(lanes.settings().soft_step.simd_lanes);
+  const std::vector<BodyId> scalar_bodies = build(&scalar);
+  const std::vector<BodyId> lane_bodies = build(&lanes);
+  std::size_t most_reports = 0;
+  for (int step = 0; step < steps; ++step) {
+    scalar.Step();
+    lanes.Step();
+    ASSERT_EQ(HashBodies(lanes, lane_bodies), HashBodies(scalar, scalar_bodies)) << "step " << step;
+    ASSERT_EQ(HashContacts(lanes), HashContacts(scalar)) << "step " << step;
+    most_reports = std::max(most_reports, scalar.contacts().size());
+  }
+  EXPECT_GT(most_reports, 40u);
+}
+
+TEST(ThreadsTest, SoftStepLanesStepLikeTheScalarUpdateOnPiles) {
+  ExpectLanesStepLikeTheScalarUpdate(BuildPiles, 1, 400);
+  ExpectLanesStepLikeTheScalarUpdate(BuildPiles, 2, 200);
+}
+
+TEST(ThreadsTest, SoftStepLanesStepLikeTheScalarUpdateOnAPyramid) {
+  ExpectLanesStepLikeTheScalarUpdate([](World* world) { return BuildPyramid(world, 12); }, 1, 240);
 }
 
 }  // namespace

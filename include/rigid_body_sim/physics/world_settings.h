@@ -112,6 +112,11 @@ struct SoftStepSettings {
   // m/s, > 0: the fastest a contact's spring pushes penetrating bodies
   // apart (it moves them; it adds no momentum that stays).
   double max_push_velocity = 3.0;
+  // Whether the sub-steps update four contacts of a colour at once, one per
+  // lane of a SIMD vector (solver/soft_contact_lanes.h), which gives bit for
+  // bit the result of one at a time in less time; false updates them one
+  // at a time, the reference.
+  bool simd_lanes = true;
 };
 
 // The most sub-steps SoftStepSettings::substeps may ask for.

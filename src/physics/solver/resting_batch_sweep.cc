@@ -34,12 +34,6 @@ struct BatchVelocities {
   out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-// out = a . b, added left to right as Eigen adds a 3-vector's products.
-[[gnu::always_inline]] inline void Dot(const LaneDoubles (&a)[3], const LaneDoubles (&b)[3],
-                                       LaneDoubles* out) {
-  *out = (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
-}
-
 // *target = value in the lanes of `active`; with kAllActive every lane is,
 // and no lane needs selecting.
 template <bool kAllActive>
@@ -59,9 +53,7 @@ template <bool kAllActive>
   const LaneDoubles zero = {};
   const LaneDoubles norm_squared = tangent[0] * tangent[0] + tangent[1] * tangent[1];
   const LaneMask outside = norm_squared > limit * limit;
-  bool any_outside = false;
-  for (int lane = 0; lane < kBatchLanes; ++lane) any_outside |= outside[lane] != 0;
-  if (!any_outside) return;
+  if (!AnyLane(outside)) return;
   const LaneDoubles norm = {std::sqrt(norm_squared[0]), std::sqrt(norm_squared[1]),
                             std::sqrt(norm_squared[2]), std::sqrt(norm_squared[3])};
   const LaneDoubles scale = norm > zero ? limit / norm : zero;
@@ -312,20 +304,6 @@ template <bool kPseudo>
 // Built twice, for AVX2 (four lanes per instruction) and for the baseline
 // x86-64 (two), the loader picking the one the processor runs; neither
 // fuses a multiply and an add, so both give the scalar sweep's result.
-// ThreadSanitizer instruments the generated ifunc resolver, which the
-// loader runs before the sanitizer's runtime is up, so a TSan build (and
-// any non-x86 target) gets the one baseline version.
-#if defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define RBS_THREAD_SANITIZER 1
-#endif
-#endif
-#if defined(__x86_64__) && !defined(__SANITIZE_THREAD__) && !defined(RBS_THREAD_SANITIZER)
-#define RBS_SIMD_CLONES [[gnu::target_clones("avx2", "default")]]
-#else
-#define RBS_SIMD_CLONES
-#endif
-
 RBS_SIMD_CLONES void SweepBatches(RestingBatches* batches, std::vector<SolverBody>* bodies,
                                   std::vector<RestingIsland>* islands) {
   SweepAllBatches(batches, bodies, islands);

@@ -23,6 +23,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "physics/solver/simd_lanes.h"
+
 namespace rigid_body_sim::physics {
 
 // Declared in contact_solver.h, which holds the batches.
@@ -30,17 +32,6 @@ struct RestingIsland;
 struct RestingRow;
 struct SolverBody;
 struct SweepTask;
-
-inline constexpr int kBatchLanes = 4;
-
-// Four doubles, one per lane (the vector extension of GCC and Clang:
-// arithmetic and comparisons lane by lane, IEEE in each), aligned to their
-// size in every translation unit: without AVX, GCC would align them to 16
-// bytes only, where the AVX build of the sweep loads them aligned to 32.
-using LaneDoubles = double __attribute__((vector_size(8 * kBatchLanes), aligned(8 * kBatchLanes)));
-// All bits set in a lane where a comparison holds.
-using LaneMask =
-    std::int64_t __attribute__((vector_size(8 * kBatchLanes), aligned(8 * kBatchLanes)));
 
 // The k-th row of each run of a batch, what differs from row to row of a
 // RestingRow, in structure-of-arrays form; [axis] is x, y, z in the world

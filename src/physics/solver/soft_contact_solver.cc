@@ -83,6 +83,27 @@ struct SoftContactSolver::PairVelocities {
   Vec3 v_a, w_a, v_b, w_b;
 };
 
+// Each block's constraints are prepared and at once packed, while they are
+// in the cache; then this thread's share of the overflow set is prepared.
+template <typename PrepareConstraint>
+void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
+                                             const PrepareConstraint& prepare) {
+  const std::vector<std::uint32_t>& start = colouring_.colour_start;
+  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+    const std::size_t first_block = block_start_[colour];
+    const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+    for (std::size_t b = begin; b < end; ++b) {
+      const std::uint32_t first = start[colour] + static_cast<std::uint32_t>(b * kBatchLanes);
+      const int lanes =
+          static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
+      for (int lane = 0; lane < lanes; ++lane) prepare(first + lane);
+      PackSoftBlock(constraints_, moving_mask_, first, lanes, &blocks_[first_block + b]);
+    }
+  }
+  const auto [begin, end] = Share(colouring_.overflow_count(), thread, threads);
+  for (std::size_t k = start.back() + begin; k < start.back() + end; ++k) prepare(k);
+}
+
 void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
                              std::vector<SoftBody>* bodies, std::vector<SolverManifold>* manifolds,
                              std::vector<FrictionAnchor>* anchors) {
@@ -93,20 +114,21 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   collision_velocity_threshold_ = input.collision_velocity_threshold;
   touch_tolerance_ = input.touch_tolerance;
   load_tracking_ = input.settings.load_tracking;
+  lanes_ = input.settings.simd_lanes;
   may_bounce_.store(false, std::memory_order_relaxed);
   moving_.clear();
   moving_mask_.assign(bodies->size(), 0);
   states_.resize(bodies->size());
   auto load = [&](std::uint32_t i) {
     const SoftBody& body = (*bodies)[i];
-    states_[i] = State{body.linear_velocity, body.angular_velocity, Vec3::Zero(), Vec3::Zero(),
-                       Quat::Identity()};
+    states_[i] = State{body.linear_velocity, body.angular_velocity, Vec3::Zero(), Vec3::Zero()};
   };
   for (const std::uint32_t i : *input.moving) {
     if (!(*bodies)[i].moving) continue;
     moving_.push_back(i);
     moving_mask_[i] = 1;
     load(i);
+    (*bodies)[i].delta_rotation = Quat::Identity();
   }
   for (const SolverManifold& manifold : *manifolds) {
     if (!moving_mask_[manifold.body_a]) load(manifold.body_a);
@@ -120,20 +142,32 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     body_b_[m] = (*manifolds)[m].body_b;
   }
   ColourConstraints(body_a_, body_b_, moving_mask_, &colour_masks_, &colour_of_, &colouring_);
+  // The constraints are stored in the colouring's order, so that each pass
+  // walks them front to back in memory: constraint k is manifold order[k].
   constraints_.resize(manifolds->size());
+  const std::vector<std::uint32_t>& order = colouring_.order;
+  ListBlocks();
   // Every thread prepares, solves and stores its share; the barriers keep
   // the stages apart.
   const int threads = pool->threads();
   SpinBarrier barrier(threads);
+  auto prepare = [&](std::size_t k) {
+    const std::uint32_t m = order[k];
+    Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], &constraints_[k]);
+  };
   auto run = [&](int thread) {
     const auto [begin, end] = Share(constraints_.size(), thread, threads);
-    for (std::size_t m = begin; m < end; ++m) {
-      Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], &constraints_[m]);
+    if (blocks_.empty()) {
+      for (std::size_t k = begin; k < end; ++k) prepare(k);
+    } else {
+      PrepareAndPackBlocks(thread, threads, prepare);
     }
     barrier.Wait();
     RunSubsteps(thread, threads, &barrier);
-    for (std::size_t m = begin; m < end; ++m)
-      Store(constraints_[m], &(*manifolds)[m], &(*anchors)[m]);
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t m = order[k];
+      Store(constraints_[k], &(*manifolds)[m], &(*anchors)[m]);
+    }
     const auto [first, last] = Share(moving_.size(), thread, threads);
     for (std::size_t k = first; k < last; ++k) {
       SoftBody& body = (*bodies)[moving_[k]];
@@ -141,7 +175,6 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
       body.linear_velocity = state.linear_velocity;
       body.angular_velocity = state.angular_velocity;
       body.delta_position = state.delta_position;
-      body.delta_rotation = state.delta_rotation;
     }
   };
   if (threads == 1) {
@@ -277,6 +310,8 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
     barrier->Wait();
     RunPass(Pass::kRelax, thread, threads, barrier);
   }
+  UnpackBlocks(thread, threads);
+  barrier->Wait();
   // Every thread reads the flag after the last relax pass's barrier, so all
   // take the same branch.
   if (may_bounce_.load(std::memory_order_relaxed)) {
@@ -287,20 +322,65 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
 void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier) {
   const std::vector<std::uint32_t>& start = colouring_.colour_start;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
-    const std::size_t size = start[colour + 1] - start[colour];
-    const auto [begin, end] = Share(size, thread, threads);
-    for (std::size_t k = start[colour] + begin; k < start[colour] + end; ++k) {
-      Apply(pass, &constraints_[colouring_.order[k]]);
+    if (!blocks_.empty() && pass != Pass::kRestitution) {
+      ApplyToBlocks(pass, colour, thread, threads);
+    } else {
+      const std::size_t size = start[colour + 1] - start[colour];
+      const auto [begin, end] = Share(size, thread, threads);
+      for (std::size_t k = start[colour] + begin; k < start[colour] + end; ++k) {
+        Apply(pass, &constraints_[k]);
+      }
     }
     barrier->Wait();
   }
   if (colouring_.overflow_count() == 0) return;
   if (thread == 0) {
-    for (std::size_t k = start.back(); k < colouring_.order.size(); ++k) {
-      Apply(pass, &constraints_[colouring_.order[k]]);
+    for (std::size_t k = start.back(); k < constraints_.size(); ++k) {
+      Apply(pass, &constraints_[k]);
     }
   }
   barrier->Wait();
+}
+
+// Four consecutive constraints of a colour to a block, the colour's last
+// block holding what is left; none without simd_lanes.
+void SoftContactSolver::ListBlocks() {
+  block_start_.assign(1, 0);
+  if (!lanes_) {
+    blocks_.clear();
+    return;
+  }
+  const std::vector<std::uint32_t>& start = colouring_.colour_start;
+  std::size_t count = 0;
+  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+    const std::size_t size = start[colour + 1] - start[colour];
+    count += (size + kBatchLanes - 1) / kBatchLanes;
+    block_start_.push_back(static_cast<std::uint32_t>(count));
+  }
+  // Kept from step to step: PackSoftBlock writes what a block's rows use.
+  blocks_.resize(count);
+}
+
+void SoftContactSolver::UnpackBlocks(int thread, int threads) {
+  const auto [begin, end] = Share(blocks_.size(), thread, threads);
+  for (std::size_t b = begin; b < end; ++b) UnpackSoftBlock(blocks_[b], &constraints_);
+}
+
+void SoftContactSolver::ApplyToBlocks(Pass pass, int colour, int thread, int threads) {
+  SoftLaneContext context;
+  context.states = &states_;
+  context.h = h_;
+  context.max_push_velocity = max_push_velocity_;
+  context.collision_velocity_threshold = collision_velocity_threshold_;
+  const std::size_t first_block = block_start_[colour];
+  const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+  SoftLaneBlock* const from = blocks_.data() + first_block + begin;
+  SoftLaneBlock* const to = blocks_.data() + first_block + end;
+  if (pass == Pass::kWarmStart) {
+    WarmStartSoftBlocks(context, from, to);
+  } else if (SolveSoftBlocks(context, pass == Pass::kSolve, from, to)) {
+    may_bounce_.store(true, std::memory_order_relaxed);
+  }
 }
 
 void SoftContactSolver::Apply(Pass pass, Constraint* constraint) {
@@ -345,7 +425,7 @@ void SoftContactSolver::IntegratePositions(int thread, int threads) {
     state.delta_position += h_ * state.linear_velocity;
     state.delta_angle += h_ * state.angular_velocity;
     const Vec3 half_turn = 0.5 * h_ * state.angular_velocity;
-    Quat& q = state.delta_rotation;
+    Quat& q = bodies[i].delta_rotation;
     const Quat spin(0.0, half_turn.x(), half_turn.y(), half_turn.z());
     q.coeffs() += (spin * q).coeffs();
     q.normalize();

@@ -31,6 +31,8 @@
 #include "physics/contact/contact_cache.h"
 #include "physics/solver/constraint_colouring.h"
 #include "physics/solver/contact_solver.h"
+#include "physics/solver/soft_contact_lanes.h"
+#include "physics/solver/soft_contact_rows.h"
 #include "physics/world/spin_barrier.h"
 #include "physics/world/task_pool.h"
 #include "rigid_body_sim/physics/types.h"
@@ -85,74 +87,9 @@ class SoftContactSolver {
   const ConstraintColouring& colouring() const { return colouring_; }
 
  private:
-  // What the rows read and write of a body in the sub-steps, packed: the
-  // velocities, and the motion since the step began, dx and the rotation
-  // vector dtheta = sum h w, which the rows use to first order (a point r
-  // from the centre has moved dx + dtheta x r).
-  struct State {
-    Vec3 linear_velocity;
-    Vec3 angular_velocity;
-    Vec3 delta_position;
-    Vec3 delta_angle;
-    Quat delta_rotation;  // the same turn, exactly, for the new pose
-  };
-  // A normal row, with its Jacobian's angular parts r x n and I^-1 (r x n)
-  // precomputed: v_n = n.(v_a - v_b) + (r_a x n).w_a - (r_b x n).w_b.
-  struct Point {
-    Vec3 rn_a;  // r_a x n
-    Vec3 rn_b;
-    Vec3 ang_a;  // I_a^-1 (r_a x n)
-    Vec3 ang_b;
-    double start_separation;    // m, s0
-    double normal_mass;         // kg
-    double normal_impulse;      // N s, of the current sub-step
-    double preload;             // N s per sub-step (CachedImpulse::preload)
-    double max_normal_impulse;  // N s, the largest push of any sub-step
-    double total_normal_impulse;
-    double approach_velocity;  // m/s, v_n as the point closed (< 0: approaching)
-    bool closed;               // a sub-step's motion would close its gap
-    bool carried;              // closed in the last step (its approach_velocity is that)
-    bool touched;              // closed, and within touch_tolerance at the step's end
-  };
-  // A manifold's rows. Friction acts at the points' centroid c: two tangent
-  // rows (their 2x2 block inverted) and a twist row about the normal, bounded
-  // by mu times the manifold's whole normal impulse (times the points' mean
-  // distance from c, for the twist).
-  struct Constraint {
-    std::uint32_t body_a;
-    std::uint32_t body_b;
-    Vec3 normal;  // from B to A
-    std::array<Vec3, 2> tangent;
-    double inverse_mass_a;
-    double inverse_mass_b;
-    double friction;
-    double restitution;
-    double bias_rate;  // 1/s
-    double mass_scale;
-    double impulse_scale;
-    int point_count;
-    std::array<Vec3, 2> ct_a;  // c_a x t_k
-    std::array<Vec3, 2> ct_b;
-    std::array<Vec3, 2> ang_t_a;  // I_a^-1 (c_a x t_k)
-    std::array<Vec3, 2> ang_t_b;
-    Vec3 twist_a;  // I_a^-1 n
-    Vec3 twist_b;
-    std::array<double, 3> tangent_block;  // K_t^-1: xx, xy, yy, kg
-    double twist_mass;                    // kg m^2
-    double twist_arm;                     // m
-    // The friction anchors (FrictionAnchor) as offsets from the centres of
-    // mass at the step's start; their slip along t_k at the start, and
-    // anchor x t_k for its change with the bodies' turn.
-    Vec3 anchor_a;
-    Vec3 anchor_b;
-    std::array<double, 2> slip_start;
-    std::array<Vec3, 2> anchor_t_a;
-    std::array<Vec3, 2> anchor_t_b;
-    std::array<double, 2> tangent_impulse;  // N s, of the current sub-step
-    double twist_impulse;                   // N m s
-    std::array<double, 2> total_tangent_impulse;
-    std::array<Point, ContactManifold::kMaxPoints> points;
-  };
+  using State = SoftRowState;
+  using Point = SoftPoint;
+  using Constraint = SoftConstraint;
   enum class Pass { kWarmStart, kSolve, kRelax, kRestitution };
   struct PairVelocities;  // soft_contact_solver.cc
 
@@ -172,6 +109,16 @@ class SoftContactSolver {
   void IntegrateVelocities(int thread, int threads);
   void IntegratePositions(int thread, int threads);
   void RunSubsteps(int thread, int threads, SpinBarrier* barrier);
+  // The blocks of four constraints of one colour for the lane updates
+  // (soft_contact_lanes.h); this thread's share of their preparing and
+  // packing, and of their unpacking.
+  void ListBlocks();
+  template <typename PrepareConstraint>
+  void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
+  void UnpackBlocks(int thread, int threads);
+  // The lane updates of `pass` on this thread's share of colour `colour`'s
+  // blocks.
+  void ApplyToBlocks(Pass pass, int colour, int thread, int threads);
   void StoreAnchor(const Constraint& constraint, FrictionAnchor* anchor) const;
   void Store(const Constraint& constraint, SolverManifold* manifold, FrictionAnchor* anchor) const;
 
@@ -185,7 +132,10 @@ class SoftContactSolver {
   std::vector<std::uint8_t> moving_mask_;  // per body
   std::vector<std::uint32_t> colour_masks_;
   std::vector<std::uint8_t> colour_of_;
-  double h_ = 0.0;  // s, the sub-step
+  bool lanes_ = true;  // SoftStepSettings::simd_lanes
+  std::vector<SoftLaneBlock> blocks_;
+  std::vector<std::uint32_t> block_start_;  // colour c's blocks: [block_start_[c], [c + 1])
+  double h_ = 0.0;                          // s, the sub-step
   int substeps_ = 1;
   double max_push_velocity_ = 0.0;
   double collision_velocity_threshold_ = 0.0;

@@ -1,0 +1,104 @@
+// The soft step's row updates four constraints at a time, one per lane of a
+// SIMD vector (simd_lanes.h). The constraints of one colour share no moving
+// body (constraint_colouring.h), so the soft step may update them in any
+// order with the same result; a block holds up to four consecutive
+// constraints of one colour. Each lane does what SoftContactSolver's scalar
+// WarmStart and Solve do for its constraint, with the same floating-point
+// operations in the same order; what the scalar code decides by a branch, a
+// lane decides by selecting between the two results, and a point a lane's
+// manifold lacks keeps every value. So the lanes give the scalar update's
+// result bit for bit (soft_step_test), as the exact solver's batches do;
+// Box2D v3 (Catto 2024, src/contact_solver.c) solves its colours' contacts
+// in SIMD lanes the same way, in floats.
+#ifndef RIGID_BODY_SIM_PHYSICS_SOLVER_SOFT_CONTACT_LANES_H_
+#define RIGID_BODY_SIM_PHYSICS_SOLVER_SOFT_CONTACT_LANES_H_
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "physics/solver/simd_lanes.h"
+#include "physics/solver/soft_contact_rows.h"
+
+namespace rigid_body_sim::physics {
+
+// A point row of each lane's constraint; [axis] is x, y, z in the world.
+struct SoftLanePoint {
+  LaneDoubles rn_a[3];  // r_a x n
+  LaneDoubles rn_b[3];
+  LaneDoubles ang_a[3];  // I_a^-1 (r_a x n)
+  LaneDoubles ang_b[3];
+  LaneDoubles start_separation;  // m
+  LaneDoubles normal_mass;       // kg
+  LaneDoubles normal_impulse;    // N s
+  LaneDoubles preload;           // N s
+  LaneDoubles max_normal_impulse;
+  LaneDoubles total_normal_impulse;
+  LaneDoubles approach_velocity;  // m/s
+  LaneMask closed;
+  LaneMask present;  // the lane's manifold has this point
+};
+
+// Up to four constraints of one colour in structure-of-arrays form: the
+// SoftConstraint fields the sub-steps read and write.
+struct SoftLaneBlock {
+  std::array<std::uint32_t, kBatchLanes> constraint;  // index in the solver's constraints
+  std::array<std::uint32_t, kBatchLanes> body_a;
+  std::array<std::uint32_t, kBatchLanes> body_b;
+  std::array<bool, kBatchLanes> moves_a;  // the solve writes the body's velocities
+  std::array<bool, kBatchLanes> moves_b;
+  int lanes;       // lanes holding a constraint, the first ones
+  int max_points;  // the most points of any lane's manifold
+  LaneDoubles normal[3];
+  LaneDoubles tangent[2][3];
+  LaneDoubles inverse_mass_a;
+  LaneDoubles inverse_mass_b;
+  LaneDoubles friction;
+  LaneDoubles bias_rate;
+  LaneDoubles mass_scale;
+  LaneDoubles impulse_scale;
+  LaneDoubles ct_a[2][3];
+  LaneDoubles ct_b[2][3];
+  LaneDoubles ang_t_a[2][3];
+  LaneDoubles ang_t_b[2][3];
+  LaneDoubles twist_a[3];
+  LaneDoubles twist_b[3];
+  LaneDoubles tangent_block[3];
+  LaneDoubles twist_mass;
+  LaneDoubles twist_arm;
+  LaneDoubles slip_start[2];
+  LaneDoubles anchor_t_a[2][3];
+  LaneDoubles anchor_t_b[2][3];
+  LaneDoubles tangent_impulse[2];
+  LaneDoubles twist_impulse;
+  LaneDoubles total_tangent_impulse[2];
+  std::array<SoftLanePoint, ContactManifold::kMaxPoints> points;
+};
+
+// What the lane updates read besides the blocks.
+struct SoftLaneContext {
+  std::vector<SoftRowState>* states = nullptr;  // per body
+  double h = 0.0;                               // s, the sub-step
+  double max_push_velocity = 0.0;               // m/s
+  double collision_velocity_threshold = 0.0;    // m/s
+};
+
+// Packs constraints [first, first + lanes) into *block; the other lanes
+// hold no constraint. moving[b] is nonzero for a body the solve writes.
+void PackSoftBlock(const std::vector<SoftConstraint>& constraints,
+                   const std::vector<std::uint8_t>& moving, std::uint32_t first, int lanes,
+                   SoftLaneBlock* block);
+// Writes back what the sub-steps changed into the block's constraints.
+void UnpackSoftBlock(const SoftLaneBlock& block, std::vector<SoftConstraint>* constraints);
+
+// SoftContactSolver::WarmStart on each constraint of blocks [begin, end).
+void WarmStartSoftBlocks(const SoftLaneContext& context, SoftLaneBlock* begin, SoftLaneBlock* end);
+// SoftContactSolver::Solve (use_bias: the solve pass, else the relax pass)
+// on each constraint of blocks [begin, end). Returns whether a point closed
+// faster than the collision threshold.
+bool SolveSoftBlocks(const SoftLaneContext& context, bool use_bias, SoftLaneBlock* begin,
+                     SoftLaneBlock* end);
+
+}  // namespace rigid_body_sim::physics
+
+#endif  // RIGID_BODY_SIM_PHYSICS_SOLVER_SOFT_CONTACT_LANES_H_
