@@ -16,7 +16,8 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
   time_step_ = time_step;
   // Sized, not cleared: World loads the bodies the contacts reach.
   bodies_.resize(body_count);
-  manifolds_.clear();
+  // The manifolds are sized and built afresh by
+  // WorldImpl::BuildSolverManifolds, which follows.
   schedules_.resize(1);
   schedules_.front().clear();
 }

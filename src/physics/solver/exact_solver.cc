@@ -88,7 +88,7 @@ void ExactSolver::SolveTouching(const StepContext& step,
                                 const std::vector<ShapePairContact*>& pairs) {
   world_.solver_.Reset(world_.settings_.solver, step.dt, world_.bodies_.size());
   LoadVelocities(world_.bodies_, world_.moving_bodies_, pairs, &world_.solver_.bodies());
-  world_.BuildSolverManifolds(pairs);
+  world_.BuildSolverManifolds(pairs, step);
   world_.SeedNewSupportLoads(pairs, step);
   world_.solver_.Prepare();
 

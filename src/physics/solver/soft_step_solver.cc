@@ -44,7 +44,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   w.ListMovingBodies();
   w.articulations_.TakeLinkPairs(w.contact_cache_.touching(), &w.rigid_pairs_);
   w.solver_.Reset(w.settings_.solver, step.dt, w.bodies_.size());
-  w.BuildSolverManifolds(w.rigid_pairs_);
+  w.BuildSolverManifolds(w.rigid_pairs_, step);
   SeedNewSupports(step);
   LoadBodies(step);
   SoftStepInput input;

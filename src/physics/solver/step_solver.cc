@@ -20,6 +20,10 @@ namespace {
 // boxes).
 constexpr std::size_t kMaxCollisionLogSize = 100000;
 
+// Manifolds a thread takes at a time when the solver manifolds are built
+// and the contacts reported on the pool.
+constexpr std::size_t kManifoldsPerChunk = 256;
+
 }  // namespace
 
 // A resting report of point i of a pair from its cached impulses, with
@@ -131,16 +135,19 @@ void WorldImpl::ListMovingBodies() {
 
 // One solver manifold per touching pair, with its points' lever arms,
 // combined materials and last step's impulses.
-void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs) {
+void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs,
+                                     const StepContext& step) {
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  manifolds.reserve(pairs.size());
-  for (std::size_t m = 0; m < pairs.size(); ++m) {
+  // Sized, not cleared and grown: a manifold with its four points is 648
+  // bytes, and each is built afresh below, on the pool.
+  manifolds.resize(pairs.size());
+  step.pool->ParallelFor(pairs.size(), kManifoldsPerChunk, [&](std::size_t m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
     const ShapePairContact* pair = pairs[m];
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
-    // Built in place: a manifold with its four points is 648 bytes.
-    SolverManifold& manifold = manifolds.emplace_back();
+    SolverManifold& manifold = manifolds[m];
+    manifold = SolverManifold();
     manifold.body_a = pair->body_a;
     manifold.body_b = pair->body_b;
     manifold.normal_world = pair->manifold.normal_world;
@@ -161,7 +168,7 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
       point.preload = pair->warm_start[i].preload;
       point.carried_approach = pair->warm_start[i].approach_velocity;
     }
-  }
+  });
 }
 
 // Keeps the impulses for next step's warm start, and reports the points
@@ -170,33 +177,59 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
                                bool impacts_only) {
   const std::vector<SolverManifold>& manifolds = solver_.manifolds();
   if (!impacts_only) ReportSleepingContacts(step);
-  for (std::size_t m = 0; m < manifolds.size(); ++m) {
+  // A collision is reported only where an impulse resolved it; a sub-step
+  // after an impact reports only its collisions, the step's own report
+  // holding the resting contacts.
+  const double contact_tolerance = settings_.solver.contact_tolerance;
+  auto reported = [&](const SolverPoint& point) {
+    const bool touching = point.separation <= contact_tolerance;
+    const bool collided = point.type == ContactType::kColliding &&
+                          point.collision_impulse + point.normal_impulse > 0.0;
+    const bool shown = point.type == ContactType::kColliding ? collided : touching;
+    return shown && (!impacts_only || collided);
+  };
+  // On the pool: each pair keeps its points for the next step's warm start
+  // and counts its reports; their offsets in contacts_ follow, in manifold
+  // order; then each pair writes its reports there.
+  const std::size_t count = manifolds.size();
+  report_offsets_.assign(count + 1, 0);
+  step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
     const SolverManifold& manifold = manifolds[m];
     ShapePairContact& pair = *pairs[m];
     pair.previous_count = manifold.point_count;
+    std::uint32_t reports = 0;
     for (int i = 0; i < manifold.point_count; ++i) {
       const SolverPoint& point = manifold.points[i];
       pair.previous[i] =
           CachedImpulse{point.feature,         point.normal_impulse,
                         point.tangent_impulse, pair.manifold.points[i].position_world,
                         point.preload,         point.carried_approach};
-      const bool touching = point.separation <= settings_.solver.contact_tolerance;
-      const double impulse = point.collision_impulse + point.normal_impulse;
-      // A collision is reported only where an impulse resolved it; a
-      // sub-step after an impact reports only its collisions, the step's
-      // own report holding the resting contacts.
-      const bool collided = point.type == ContactType::kColliding && impulse > 0.0;
-      const bool reported = point.type == ContactType::kColliding ? collided : touching;
-      if (!reported || (impacts_only && !collided)) continue;
-      ContactReport& report =
-          contacts_.emplace_back(MakeReport(pair, i, manifold.tangent_world, step));
+      reports += reported(point) ? 1 : 0;
+    }
+    report_offsets_[m + 1] = reports;
+  });
+  report_offsets_[0] = static_cast<std::uint32_t>(contacts_.size());
+  for (std::size_t m = 0; m < count; ++m) report_offsets_[m + 1] += report_offsets_[m];
+  const std::size_t first_report = contacts_.size();
+  contacts_.resize(report_offsets_[count]);
+  step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
+    const SolverManifold& manifold = manifolds[m];
+    const ShapePairContact& pair = *pairs[m];
+    std::uint32_t next = report_offsets_[m];
+    for (int i = 0; i < manifold.point_count; ++i) {
+      const SolverPoint& point = manifold.points[i];
+      if (!reported(point)) continue;
+      ContactReport& report = contacts_[next++];
+      report = MakeReport(pair, i, manifold.tangent_world, step);
       report.normal_velocity = point.normal_velocity_before;
       report.type = point.type;
-      report.normal_impulse = impulse;
+      report.normal_impulse = point.collision_impulse + point.normal_impulse;
       report.normal_force = report.normal_impulse / step.dt;
-      if (report.type == ContactType::kColliding) collision_log_.push_back(report);
     }
+  });
+  for (std::size_t k = first_report; k < contacts_.size(); ++k) {
+    if (contacts_[k].type == ContactType::kColliding) collision_log_.push_back(contacts_[k]);
   }
   if (collision_log_.size() > 2 * kMaxCollisionLogSize) {
     collision_log_.erase(collision_log_.begin(),

@@ -70,6 +70,13 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
   std::vector<UprightSupport> supports;
   const double g = input.gravity.norm();
   if (g <= 0.0) return supports;
+  // Most steps have no new pair at all: then no support is new, and the
+  // supports need not be listed.
+  bool any_new_pair = false;
+  for (std::size_t m = 0; m < manifolds.size() && !any_new_pair; ++m) {
+    any_new_pair = (*input.pairs)[m]->previous_count == 0 && manifolds[m].point_count > 0;
+  }
+  if (!any_new_pair) return supports;
   const Vec3 up = -input.gravity / g;
   // A support is upright when its normal is within 60 degrees of up.
   constexpr double kUpright = 0.5;

@@ -119,7 +119,7 @@ class WorldImpl : public LinkBodies {
   // The awake, enabled bodies that are not links into moving_bodies_.
   void ListMovingBodies();
   // What both solvers' stage 4 shares (step_solver.cc).
-  void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs);
+  void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
   void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
                       bool impacts_only);
   void ReportSleepingContacts(const StepContext& step);
@@ -184,6 +184,8 @@ class WorldImpl : public LinkBodies {
   } sleep_scratch_;
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
+  // ReportContacts' scratch: where each manifold's reports start.
+  std::vector<std::uint32_t> report_offsets_;
   std::vector<BodyId> non_finite_bodies_;
   std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
   StepProfile last_step_profile_;
