@@ -13,8 +13,13 @@ constexpr double kPositionMatchDistance = 1e-3;
 }  // namespace
 
 // Each point of this step's manifold takes the impulses of last step's point
-// with the same features, else of the nearest unmatched one.
+// with the same features, else of the nearest unmatched one; a pair with no
+// point this step keeps none for the next.
 void MatchWarmStarts(ShapePairContact* entry) {
+  if (entry->manifold.point_count == 0) {
+    entry->previous_count = 0;
+    return;
+  }
   std::array<bool, ContactManifold::kMaxPoints> taken{};  // previous points matched
   std::array<bool, ContactManifold::kMaxPoints> found{};  // this step's points matched
   for (int i = 0; i < entry->manifold.point_count; ++i) {
@@ -99,10 +104,8 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
   return *entry;
 }
 
-void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
-                                 const std::function<bool(const ShapePairContact&)>& asleep) {
-  touching_.clear();
-  keyed_.clear();
+void ContactCache::Prune(std::uint64_t step, bool recheck_frozen,
+                         const std::function<bool(const ShapePairContact&)>& asleep) {
   if (recheck_frozen) {
     for (auto it = frozen_.begin(); it != frozen_.end();) {
       if (asleep(it->second)) {
@@ -136,15 +139,13 @@ void ContactCache::MatchAndPrune(std::uint64_t step, bool recheck_frozen,
   // then the half-space pairs by body).
   seen_.swap(visited_);
   visited_.clear();
-  for (std::size_t e = 0; e < seen_.size(); ++e) {
-    PrefetchAhead(seen_, e, PrefetchPoints);
-    ShapePairContact* entry = seen_[e];
-    if (entry->manifold.point_count == 0) {
-      entry->previous_count = 0;
-      continue;
-    }
-    MatchWarmStarts(entry);
-    keyed_.emplace_back(entry->key, entry);
+}
+
+void ContactCache::ListTouching() {
+  touching_.clear();
+  keyed_.clear();
+  for (ShapePairContact* entry : seen_) {
+    if (entry->manifold.point_count > 0) keyed_.emplace_back(entry->key, entry);
   }
   // The solver's Gauss-Seidel order is the key order (body A's index first),
   // whatever order the pairs were visited in. The keys sit next to the
@@ -168,7 +169,7 @@ void ContactCache::ListSleeping() {
 }
 
 void ContactCache::RemoveBody(std::uint32_t body) {
-  // seen_ goes on listing every pair of pairs_ (MatchAndPrune looks there
+  // seen_ goes on listing every pair of pairs_ (Prune looks there
   // for the unseen ones), so the body's pairs leave it before they go.
   auto of_body = [body](const ShapePairContact* entry) {
     return entry->body_a == body || entry->body_b == body;

@@ -134,15 +134,17 @@ class ContactCache {
   // The entry of a shape pair, created empty when new; marks it seen.
   ShapePairContact& Touch(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
                           std::uint16_t shape_b, std::uint64_t step);
-  // Drops the pairs not seen in `step` unless `asleep` says both of their
-  // bodies sleep (their contacts still hold, frozen), matches every touching
-  // manifold's points with last step's by feature id, or else by position,
-  // and lists the pairs.
+  // Stage 3 in three parts. Prune drops the pairs not seen in `step` unless
+  // `asleep` says both of their bodies sleep (their contacts still hold,
+  // frozen), and lists the seen ones in seen(). The caller then matches each
+  // seen pair's points with last step's (MatchWarmStarts, one pair at a
+  // time, in any order), and ListTouching lists the touching pairs.
   // Frozen pairs are set aside and cost nothing per step; pass
   // `recheck_frozen` when a body woke or left since the last call, so that
   // frozen pairs of bodies no longer asleep go.
-  void MatchAndPrune(std::uint64_t step, bool recheck_frozen,
-                     const std::function<bool(const ShapePairContact&)>& asleep);
+  void Prune(std::uint64_t step, bool recheck_frozen,
+             const std::function<bool(const ShapePairContact&)>& asleep);
+  void ListTouching();
   // Pairs with at least one contact point this step, in key order.
   const std::vector<ShapePairContact*>& touching() const { return touching_; }
   // Every pair the narrow phase looked at this step, touching or not, in
@@ -169,16 +171,18 @@ class ContactCache {
   PairIndex<ShapePairContact> index_;  // key -> entry of pairs_, for Touch
   PairMap frozen_;                     // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
-  std::vector<ShapePairContact*> seen_;     // after MatchAndPrune, every entry of pairs_
+  std::vector<ShapePairContact*> seen_;     // after Prune, every entry of pairs_
   std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
-  std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of MatchAndPrune
+  std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of ListTouching
   std::vector<const ShapePairContact*> sleeping_;
   std::uint64_t sleeping_version_ = 0;
   bool frozen_changed_ = false;  // frozen_ differs from sleeping_
 };
 
 // Each point of `entry`'s manifold takes last step's impulses of the point
-// with the same features, else of the nearest unmatched one (warm start).
+// with the same features, else of the nearest unmatched one (warm start); a
+// pair with no point this step keeps none for the next. Reads and writes
+// only `entry`.
 void MatchWarmStarts(ShapePairContact* entry);
 
 }  // namespace rigid_body_sim::physics
