@@ -98,8 +98,10 @@ void SoftStepSolver::SeedNewSupports(const StepContext& step) {
 void SoftStepSolver::LoadBodies(const StepContext& step) {
   WorldImpl& w = world_;
   bodies_.resize(w.bodies_.size());
+  // The moving bodies are loaded on the pool below.
   for (const SolverManifold& manifold : w.solver_.manifolds()) {
     for (const std::uint32_t i : {manifold.body_a, manifold.body_b}) {
+      if (WorldImpl::MovesThisStep(w.bodies_[i])) continue;
       bodies_[i] = SoftBody();
       bodies_[i].position = w.bodies_[i].position;
       bodies_[i].orientation = w.bodies_[i].orientation;

@@ -126,10 +126,7 @@ SupportBalanceInput WorldImpl::SupportInput(const std::vector<ShapePairContact*>
 void WorldImpl::ListMovingBodies() {
   moving_bodies_.clear();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
-    const Body& body = bodies_[i];
-    if (body.in_use && !body.is_static && body.awake && !body.disabled && body.articulation < 0) {
-      moving_bodies_.push_back(i);
-    }
+    if (MovesThisStep(bodies_[i])) moving_bodies_.push_back(i);
   }
 }
 

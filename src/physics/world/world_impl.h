@@ -118,6 +118,10 @@ class WorldImpl : public LinkBodies {
   // 4 and 5, from velocities to poses, are motion_solver_'s (solver/).
   // The awake, enabled bodies that are not links into moving_bodies_.
   void ListMovingBodies();
+  // Whether ListMovingBodies lists `body`: the solve moves it this step.
+  static bool MovesThisStep(const Body& body) {
+    return body.in_use && !body.is_static && body.awake && !body.disabled && body.articulation < 0;
+  }
   // What both solvers' stage 4 shares (step_solver.cc).
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
   void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
