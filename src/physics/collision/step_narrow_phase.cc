@@ -130,9 +130,13 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
 
 // m; the margin plus the distance the two bodies can close in one step.
 double WorldImpl::ContactDistance(const Body& a, const Body& b, const StepContext& step) const {
-  const double margin =
-      std::min(settings_.contact_margin, kMarginPerThickness * std::min(a.thickness, b.thickness));
-  return margin + ContactReach(a, b, step);
+  return ContactMargin(a, b) + ContactReach(a, b, step);
+}
+
+// m; the pair's contact margin: at most a fraction of its thinner body.
+double WorldImpl::ContactMargin(const Body& a, const Body& b) const {
+  return std::min(settings_.contact_margin,
+                  kMarginPerThickness * std::min(a.thickness, b.thickness));
 }
 
 // m; a bound on how far two points of the bodies can close in one step:
@@ -216,8 +220,9 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const 
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
   if (articulations_.SkipsPair(a, b)) return;
-  const double contact_distance = ContactDistance(a, b, step);
+  // ContactDistance, with the reach found once.
   const double reach = ContactReach(a, b, step);
+  const double contact_distance = ContactMargin(a, b) + reach;
   const double travel = a.travel + b.travel;
   const bool compound = a.shapes.size() > 1 || b.shapes.size() > 1;
   // The poses, made once and only for a pair that is looked at.

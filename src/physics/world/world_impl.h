@@ -136,6 +136,7 @@ class WorldImpl : public LinkBodies {
   void CollideShapePair(NarrowJob* job) const;
   double ContactDistance(const Body& a, const Body& b, const StepContext& step) const;
   double ContactReach(const Body& a, const Body& b, const StepContext& step) const;
+  double ContactMargin(const Body& a, const Body& b) const;
   bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
