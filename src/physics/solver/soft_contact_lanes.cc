@@ -54,6 +54,9 @@ struct LaneBodies {
   LaneDoubles dx_a[3], dx_b[3], dtheta_a[3], dtheta_b[3];  // m, rad
 };
 
+// The velocities, and with kMotion the motion too (the warm start reads no
+// motion).
+template <bool kMotion>
 [[gnu::always_inline]] inline void Gather(const SoftLaneBlock& block,
                                           const std::vector<SoftRowState>& states,
                                           LaneBodies* bodies) {
@@ -65,6 +68,7 @@ struct LaneBodies {
       bodies->w_a[axis][lane] = a.angular_velocity[axis];
       bodies->v_b[axis][lane] = b.linear_velocity[axis];
       bodies->w_b[axis][lane] = b.angular_velocity[axis];
+      if constexpr (!kMotion) continue;
       bodies->dx_a[axis][lane] = a.delta_position[axis];
       bodies->dx_b[axis][lane] = b.delta_position[axis];
       bodies->dtheta_a[axis][lane] = a.delta_angle[axis];
@@ -140,7 +144,7 @@ struct LaneBodies {
 [[gnu::always_inline]] inline void WarmStartBlock(const SoftLaneContext& context,
                                                   const SoftLaneBlock& c) {
   LaneBodies v;
-  Gather(c, *context.states, &v);
+  Gather</*kMotion=*/false>(c, *context.states, &v);
   for (int i = 0; i < c.max_points; ++i) {
     ApplyNormal(c, c.points[i], c.points[i].normal_impulse, &v);
   }
@@ -268,7 +272,7 @@ struct LaneBodies {
 [[gnu::always_inline]] inline bool SolveBlock(const SoftLaneContext& context, bool use_bias,
                                               SoftLaneBlock* c) {
   LaneBodies v;
-  Gather(*c, *context.states, &v);
+  Gather</*kMotion=*/true>(*c, *context.states, &v);
   LaneDoubles separation[ContactManifold::kMaxPoints];
   const bool fast = Separations(context, c, v, separation);
   const LaneDoubles zero = {};

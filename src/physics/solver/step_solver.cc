@@ -72,7 +72,6 @@ std::vector<UprightSupport> WorldImpl::SeedNewSupportLoads(
   std::vector<UprightSupport> supports =
       UprightSupportsHighestFirst(SupportInput(pairs, step), manifolds);
   if (supports.empty()) return supports;
-  auto carries_load = [&](std::uint32_t body) { return CarriesLoad(bodies_[body]); };
   // N s: a body's load; then, from its first support on, what its new
   // supports share.
   std::vector<double> load(bodies_.size(), 0.0);
@@ -99,13 +98,13 @@ std::vector<UprightSupport> WorldImpl::SeedNewSupportLoads(
     double passed = 0.0;
     if (!support.is_new) {
       passed = warm_load(support);
-    } else if (carries_load(upper)) {
+    } else if (CarriesLoad(bodies_[upper])) {
       passed = load[upper] / new_supports[upper];
       SolverManifold& manifold = manifolds[support.manifold];
       const double per_point = passed * support.up_along_normal / manifold.point_count;
       for (int i = 0; i < manifold.point_count; ++i) manifold.points[i].normal_impulse = per_point;
     }
-    if (carries_load(support.lower)) load[support.lower] += passed;
+    if (CarriesLoad(bodies_[support.lower])) load[support.lower] += passed;
   }
   return supports;
 }
@@ -135,8 +134,8 @@ void WorldImpl::ListMovingBodies() {
 void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs,
                                      const StepContext& step) {
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  // Sized, not cleared and grown: a manifold with its four points is 648
-  // bytes, and each is built afresh below, on the pool.
+  // Resized, not cleared (ContactSolver::Reset keeps them): a manifold with
+  // its four points is 648 bytes, and each is built afresh below, on the pool.
   manifolds.resize(pairs.size());
   step.pool->ParallelFor(pairs.size(), kManifoldsPerChunk, [&](std::size_t m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
