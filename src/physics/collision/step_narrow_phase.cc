@@ -55,7 +55,10 @@ void CollideMeshSlots(const MeshVisit& visit, const ConvexMeshPair& pair) {
       visit.cache->Touch(visit.body_a, visit.shape_a, visit.body_b,
                          static_cast<std::uint16_t>(visit.shape_b), visit.step);
   first.contact_distance = pair.contact_distance;
-  if (first.apart_gap - (visit.travel - first.apart_travel) > pair.contact_distance) return;
+  if (first.apart_gap - (visit.travel - first.apart_travel) > pair.contact_distance) {
+    MatchCulled(&first);
+    return;
+  }
   thread_local MeshContacts contacts;
   CollideConvexMesh(pair, &contacts);
   for (int slot = 0; slot < StaticMesh::kContactSlots; ++slot) {
@@ -73,6 +76,7 @@ void CollideMeshSlots(const MeshVisit& visit, const ConvexMeshPair& pair) {
                           ? contacts.gap
                           : -std::numeric_limits<double>::infinity();
     entry.apart_travel = visit.travel;
+    MatchWarmStarts(&entry);
   }
 }
 
@@ -261,7 +265,10 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const 
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
                                                      static_cast<std::uint16_t>(k), step_count_);
       entry.contact_distance = contact_distance;
-      if (entry.apart_gap - (travel - entry.apart_travel) > contact_distance) continue;
+      if (entry.apart_gap - (travel - entry.apart_travel) > contact_distance) {
+        MatchCulled(&entry);
+        continue;
+      }
       narrow_jobs_.push_back({&entry, travel, false});
     }
   }
@@ -280,6 +287,7 @@ void WorldImpl::CollideShapePair(NarrowJob* job) const {
   const Pose world_from_shape_b = b.WorldFromBody() * shape_b.body_from_shape;
   if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b, &entry)) {
     job->reused = true;
+    MatchWarmStarts(&entry);
     return;
   }
   CollideInput input;
@@ -294,6 +302,7 @@ void WorldImpl::CollideShapePair(NarrowJob* job) const {
       entry.manifold.point_count == 0 ? stats.gap : -std::numeric_limits<double>::infinity();
   entry.apart_travel = job->travel;
   AnchorManifold(b_from_a, world_from_shape_a, world_from_shape_b, &entry);
+  MatchWarmStarts(&entry);
 }
 
 // The pair's manifold clipped afresh at the current poses.

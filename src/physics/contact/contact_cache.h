@@ -9,6 +9,7 @@
 #define RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_CACHE_H_
 
 #include <array>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -77,6 +78,9 @@ struct ShapePairContact {
   // two bodies then (Body::travel).
   double apart_gap = -std::numeric_limits<double>::infinity();
   double apart_travel = 0.0;
+  // Last step's points (previous), in the first line for a culled pair's
+  // match.
+  int previous_count = 0;
   SeparatingWitness witness;
   ContactManifold manifold;  // this step's
   ManifoldAnchors anchors;
@@ -87,7 +91,6 @@ struct ShapePairContact {
   std::array<CachedImpulse, ContactManifold::kMaxPoints> warm_start{};
   // Last step's points and their final impulses.
   std::array<CachedImpulse, ContactManifold::kMaxPoints> previous{};
-  int previous_count = 0;
   FrictionAnchor friction_anchor;
 };
 
@@ -134,11 +137,12 @@ class ContactCache {
   // The entry of a shape pair, created empty when new; marks it seen.
   ShapePairContact& Touch(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
                           std::uint16_t shape_b, std::uint64_t step);
-  // Stage 3 in three parts. Prune drops the pairs not seen in `step` unless
-  // `asleep` says both of their bodies sleep (their contacts still hold,
-  // frozen), and lists the seen ones in seen(). The caller then matches each
-  // seen pair's points with last step's (MatchWarmStarts, one pair at a
-  // time, in any order), and ListTouching lists the touching pairs.
+  // Each pair the narrow phase touches has its points matched with last
+  // step's (MatchWarmStarts) once its manifold is final, while the entry is
+  // in the cache. Stage 3 in two parts: Prune drops the pairs not seen in
+  // `step` unless `asleep` says both of their bodies sleep (their contacts
+  // still hold, frozen), and lists the seen ones in seen(); ListTouching
+  // lists the touching pairs.
   // Frozen pairs are set aside and cost nothing per step; pass
   // `recheck_frozen` when a body woke or left since the last call, so that
   // frozen pairs of bodies no longer asleep go.
@@ -184,6 +188,13 @@ class ContactCache {
 // pair with no point this step keeps none for the next. Reads and writes
 // only `entry`.
 void MatchWarmStarts(ShapePairContact* entry);
+// MatchWarmStarts of a pair the narrow phase culled: its gap was found with
+// no point, so it has none, and keeps none for the next step. Reads and
+// writes only the entry's first cache line.
+inline void MatchCulled(ShapePairContact* entry) {
+  assert(entry->manifold.point_count == 0);
+  entry->previous_count = 0;
+}
 
 }  // namespace rigid_body_sim::physics
 

@@ -24,6 +24,7 @@ void PackPoint(const SoftPoint& from, int lane, SoftLanePoint* to) {
   to->total_normal_impulse[lane] = from.total_normal_impulse;
   to->approach_velocity[lane] = from.approach_velocity;
   to->closed[lane] = from.closed ? -1 : 0;
+  to->carried[lane] = from.carried ? -1 : 0;
 }
 
 void PackFriction(const SoftConstraint& c, int lane, SoftLaneBlock* block) {
@@ -323,26 +324,26 @@ template <bool kMotion>
 
 }  // namespace
 
-void PackSoftBlock(const std::vector<SoftConstraint>& constraints,
-                   const std::vector<std::uint8_t>& moving, std::uint32_t first, int lanes,
-                   SoftLaneBlock* block) {
+void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int lanes,
+                   const std::vector<std::uint8_t>& moving, SoftLaneBlock* block) {
   // Only the lanes and points that hold a row are written: the others keep
   // whatever finite values an earlier step left (a new block starts at
   // zero), which the updates compute with and then discard.
   block->lanes = lanes;
   block->max_points = 0;
   for (int lane = 0; lane < kBatchLanes; ++lane) {
-    const int points = lane < lanes ? constraints[first + lane].point_count : 0;
+    const int points = lane < lanes ? constraints[lane].point_count : 0;
+    block->point_count[lane] = points;
     for (int i = 0; i < ContactManifold::kMaxPoints; ++i) {
       block->points[i].present[lane] = i < points ? -1 : 0;
     }
   }
   for (int lane = 0; lane < kBatchLanes; ++lane) {
     // A lane without a constraint reads the first lane's bodies, and is
-    // neither written back nor unpacked.
-    const std::uint32_t index = first + static_cast<std::uint32_t>(lane < lanes ? lane : 0);
-    const SoftConstraint& c = constraints[index];
-    block->constraint[lane] = index;
+    // neither written back nor stored.
+    const int from = lane < lanes ? lane : 0;
+    const SoftConstraint& c = constraints[from];
+    block->constraint[lane] = first + static_cast<std::uint32_t>(from);
     block->body_a[lane] = c.body_a;
     block->body_b[lane] = c.body_b;
     block->moves_a[lane] = lane < lanes && moving[c.body_a] != 0;
@@ -353,31 +354,60 @@ void PackSoftBlock(const std::vector<SoftConstraint>& constraints,
     block->inverse_mass_a[lane] = c.inverse_mass_a;
     block->inverse_mass_b[lane] = c.inverse_mass_b;
     block->friction[lane] = c.friction;
+    block->restitution[lane] = c.restitution;
     block->bias_rate[lane] = c.bias_rate;
     block->mass_scale[lane] = c.mass_scale;
     block->impulse_scale[lane] = c.impulse_scale;
+    SetLane(c.anchor_a, lane, block->anchor_a);
+    SetLane(c.anchor_b, lane, block->anchor_b);
     PackFriction(c, lane, block);
     for (int i = 0; i < c.point_count; ++i) PackPoint(c.points[i], lane, &block->points[i]);
   }
 }
 
-void UnpackSoftBlock(const SoftLaneBlock& block, std::vector<SoftConstraint>* constraints) {
-  for (int lane = 0; lane < block.lanes; ++lane) {
-    SoftConstraint& c = (*constraints)[block.constraint[lane]];
-    for (int i = 0; i < c.point_count; ++i) {
-      const SoftLanePoint& from = block.points[i];
-      SoftPoint& p = c.points[i];
-      p.normal_impulse = from.normal_impulse[lane];
-      p.max_normal_impulse = from.max_normal_impulse[lane];
-      p.total_normal_impulse = from.total_normal_impulse[lane];
-      p.approach_velocity = from.approach_velocity[lane];
-      p.closed = from.closed[lane] != 0;
+void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
+                           SoftConstraint* constraint) {
+  SoftConstraint& c = *constraint;
+  auto get = [lane](const LaneDoubles(&lanes)[3]) {
+    return Vec3(lanes[0][lane], lanes[1][lane], lanes[2][lane]);
+  };
+  c.body_a = block.body_a[lane];
+  c.body_b = block.body_b[lane];
+  if (rows) {
+    c.normal = get(block.normal);
+    c.inverse_mass_a = block.inverse_mass_a[lane];
+    c.inverse_mass_b = block.inverse_mass_b[lane];
+    c.restitution = block.restitution[lane];
+  }
+  c.friction = block.friction[lane];
+  c.point_count = block.point_count[lane];
+  c.anchor_a = get(block.anchor_a);
+  c.anchor_b = get(block.anchor_b);
+  for (int k = 0; k < 2; ++k) {
+    c.tangent[k] = get(block.tangent[k]);
+    c.tangent_impulse[k] = block.tangent_impulse[k][lane];
+    c.total_tangent_impulse[k] = block.total_tangent_impulse[k][lane];
+  }
+  c.twist_impulse = block.twist_impulse[lane];
+  for (int i = 0; i < c.point_count; ++i) {
+    const SoftLanePoint& from = block.points[i];
+    SoftPoint& p = c.points[i];
+    if (rows) {
+      p.rn_a = get(from.rn_a);
+      p.rn_b = get(from.rn_b);
+      p.ang_a = get(from.ang_a);
+      p.ang_b = get(from.ang_b);
+      p.start_separation = from.start_separation[lane];
+      p.normal_mass = from.normal_mass[lane];
     }
-    for (int k = 0; k < 2; ++k) {
-      c.tangent_impulse[k] = block.tangent_impulse[k][lane];
-      c.total_tangent_impulse[k] = block.total_tangent_impulse[k][lane];
-    }
-    c.twist_impulse = block.twist_impulse[lane];
+    p.normal_impulse = from.normal_impulse[lane];
+    p.preload = from.preload[lane];
+    p.max_normal_impulse = from.max_normal_impulse[lane];
+    p.total_normal_impulse = from.total_normal_impulse[lane];
+    p.approach_velocity = from.approach_velocity[lane];
+    p.closed = from.closed[lane] != 0;
+    p.carried = from.carried[lane] != 0;
+    p.touched = false;
   }
 }
 

@@ -37,6 +37,7 @@ struct SoftLanePoint {
   LaneDoubles approach_velocity;  // m/s
   LaneMask closed;
   LaneMask present;  // the lane's manifold has this point
+  LaneMask carried;  // read only after the sub-steps
 };
 
 // Up to four constraints of one colour in structure-of-arrays form: the
@@ -73,6 +74,11 @@ struct SoftLaneBlock {
   LaneDoubles twist_impulse;
   LaneDoubles total_tangent_impulse[2];
   std::array<SoftLanePoint, ContactManifold::kMaxPoints> points;
+  // Read only after the sub-steps, by the restitution pass and the store.
+  std::array<int, kBatchLanes> point_count;
+  LaneDoubles restitution;
+  LaneDoubles anchor_a[3];
+  LaneDoubles anchor_b[3];
 };
 
 // What the lane updates read besides the blocks.
@@ -83,13 +89,17 @@ struct SoftLaneContext {
   double collision_velocity_threshold = 0.0;    // m/s
 };
 
-// Packs constraints [first, first + lanes) into *block; the other lanes
-// hold no constraint. moving[b] is nonzero for a body the solve writes.
-void PackSoftBlock(const std::vector<SoftConstraint>& constraints,
-                   const std::vector<std::uint8_t>& moving, std::uint32_t first, int lanes,
-                   SoftLaneBlock* block);
-// Writes back what the sub-steps changed into the block's constraints.
-void UnpackSoftBlock(const SoftLaneBlock& block, std::vector<SoftConstraint>* constraints);
+// Packs constraints[0, lanes), the solver's constraints first to first +
+// lanes - 1, into *block; the other lanes hold no constraint. moving[b] is
+// nonzero for a body the solve writes.
+void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int lanes,
+                   const std::vector<std::uint8_t>& moving, SoftLaneBlock* block);
+// Lane `lane`'s constraint as the sub-steps left it, with the fields that
+// the store reads (SoftContactSolver::Store) and, with `rows`, the normal
+// rows' that the restitution pass reads (Restitute); the friction rows'
+// Jacobians are left unset.
+void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
+                           SoftConstraint* constraint);
 
 // SoftContactSolver::WarmStart on each constraint of blocks [begin, end).
 void WarmStartSoftBlocks(const SoftLaneContext& context, SoftLaneBlock* begin, SoftLaneBlock* end);

@@ -39,12 +39,14 @@ double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
 }  // namespace
 
-// Each block's constraints are prepared and at once packed, while they are
-// in the cache; then this thread's share of the overflow set is prepared.
+// Each block's constraints are prepared into a scratch block of four, in
+// the cache, and packed from there: the lanes keep the only copy. Then this
+// thread's share of the overflow set is prepared into the constraints.
 template <typename PrepareConstraint>
 void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
                                              const PrepareConstraint& prepare) {
   const std::vector<std::uint32_t>& start = colouring_.colour_start;
+  std::array<Constraint, kBatchLanes> scratch;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
     const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
@@ -52,18 +54,22 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
       const std::uint32_t first = start[colour] + static_cast<std::uint32_t>(b * kBatchLanes);
       const int lanes =
           static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
-      for (int lane = 0; lane < lanes; ++lane) prepare(first + lane);
-      PackSoftBlock(constraints_, moving_mask_, first, lanes, &blocks_[first_block + b]);
+      for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
+      PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks_[first_block + b]);
     }
   }
   const auto [begin, end] = Share(colouring_.overflow_count(), thread, threads);
-  for (std::size_t k = start.back() + begin; k < start.back() + end; ++k) prepare(k);
+  for (std::size_t k = start.back() + begin; k < start.back() + end; ++k) {
+    prepare(k, &constraints_[k]);
+  }
 }
 
 void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
                              std::vector<SoftBody>* bodies, std::vector<SolverManifold>* manifolds,
                              std::vector<FrictionAnchor>* anchors) {
   bodies_ = bodies;
+  manifolds_ = manifolds;
+  anchors_ = anchors;
   substeps_ = input.settings.substeps;
   h_ = input.dt / substeps_;
   max_push_velocity_ = input.settings.max_push_velocity;
@@ -107,23 +113,25 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   // the stages apart.
   const int threads = pool->threads();
   SpinBarrier barrier(threads);
-  auto prepare = [&](std::size_t k) {
+  auto prepare = [&](std::size_t k, Constraint* constraint) {
     const std::uint32_t m = order[k];
-    Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], &constraints_[k]);
+    Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], constraint);
   };
   auto run = [&](int thread) {
-    const auto [begin, end] = Share(constraints_.size(), thread, threads);
     if (blocks_.empty()) {
-      for (std::size_t k = begin; k < end; ++k) prepare(k);
+      const auto [begin, end] = Share(constraints_.size(), thread, threads);
+      for (std::size_t k = begin; k < end; ++k) prepare(k, &constraints_[k]);
     } else {
       PrepareAndPackBlocks(thread, threads, prepare);
     }
     barrier.Wait();
     RunSubsteps(thread, threads, &barrier);
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::uint32_t m = order[k];
-      Store(constraints_[k], &(*manifolds)[m], &(*anchors)[m]);
-    }
+    // The constraints not in a block: all of them without lanes, else the
+    // overflow set.
+    const std::size_t first_scalar = blocks_.empty() ? 0 : colouring_.colour_start.back();
+    const auto [begin, end] = Share(constraints_.size() - first_scalar, thread, threads);
+    for (std::size_t k = first_scalar + begin; k < first_scalar + end; ++k)
+      Store(k, constraints_[k]);
     const auto [first, last] = Share(moving_.size(), thread, threads);
     for (std::size_t k = first; k < last; ++k) {
       SoftBody& body = (*bodies)[moving_[k]];
@@ -266,13 +274,42 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
     barrier->Wait();
     RunPass(Pass::kRelax, thread, threads, barrier);
   }
-  UnpackBlocks(thread, threads);
-  barrier->Wait();
   // Every thread reads the flag after the last relax pass's barrier, so all
   // take the same branch.
-  if (may_bounce_.load(std::memory_order_relaxed)) {
-    RunPass(Pass::kRestitution, thread, threads, barrier);
+  const bool bounce = may_bounce_.load(std::memory_order_relaxed);
+  if (blocks_.empty()) {
+    if (bounce) RunPass(Pass::kRestitution, thread, threads, barrier);
+    return;
   }
+  StoreBlocks(bounce, thread, threads, barrier);
+}
+
+// Each block's constraints taken out of their lanes, restituted (when a
+// point closed fast) and stored, colour by colour; then the overflow set's
+// restitution. A constraint's store reads only its own rows, so it follows
+// its restitution at once.
+void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBarrier* barrier) {
+  Constraint c;
+  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+    const std::size_t first_block = block_start_[colour];
+    const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+    for (std::size_t b = first_block + begin; b < first_block + end; ++b) {
+      const SoftLaneBlock& block = blocks_[b];
+      for (int lane = 0; lane < block.lanes; ++lane) {
+        ExtractSoftConstraint(block, lane, /*rows=*/bounce, &c);
+        if (bounce) Restitute(&c);
+        Store(block.constraint[lane], c);
+      }
+    }
+    if (bounce) barrier->Wait();
+  }
+  if (!bounce || colouring_.overflow_count() == 0) return;
+  if (thread == 0) {
+    for (std::size_t k = colouring_.colour_start.back(); k < constraints_.size(); ++k) {
+      Restitute(&constraints_[k]);
+    }
+  }
+  barrier->Wait();
 }
 
 void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier) {
@@ -315,11 +352,6 @@ void SoftContactSolver::ListBlocks() {
   }
   // Kept from step to step: PackSoftBlock writes what a block's rows use.
   blocks_.resize(count);
-}
-
-void SoftContactSolver::UnpackBlocks(int thread, int threads) {
-  const auto [begin, end] = Share(blocks_.size(), thread, threads);
-  for (std::size_t b = begin; b < end; ++b) UnpackSoftBlock(blocks_[b], &constraints_);
 }
 
 void SoftContactSolver::ApplyToBlocks(Pass pass, int colour, int thread, int threads) {
@@ -409,9 +441,10 @@ void SoftContactSolver::StoreAnchor(const Constraint& c, FrictionAnchor* anchor)
 // (colliding when it touched after closing faster than the collision
 // threshold, and was pushed; else resting), its new preload, and the
 // approach speed of a point that closed but has not touched yet.
-void SoftContactSolver::Store(const Constraint& c, SolverManifold* manifold,
-                              FrictionAnchor* anchor) const {
-  StoreAnchor(c, anchor);
+void SoftContactSolver::Store(std::size_t k, const Constraint& c) const {
+  const std::uint32_t m = colouring_.order[k];
+  SolverManifold* manifold = &(*manifolds_)[m];
+  StoreAnchor(c, &(*anchors_)[m]);
   manifold->tangent_world = c.tangent;
   // The friction impulse is shared among the points as their normal
   // impulses are (equally when none pushed).

@@ -111,20 +111,26 @@ class SoftContactSolver {
   void RunSubsteps(int thread, int threads, SpinBarrier* barrier);
   // The blocks of four constraints of one colour for the lane updates
   // (soft_contact_lanes.h); this thread's share of their preparing and
-  // packing, and of their unpacking.
+  // packing, and of their restitution and store after the sub-steps.
   void ListBlocks();
   template <typename PrepareConstraint>
   void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
-  void UnpackBlocks(int thread, int threads);
+  void StoreBlocks(bool bounce, int thread, int threads, SpinBarrier* barrier);
   // The lane updates of `pass` on this thread's share of colour `colour`'s
   // blocks.
   void ApplyToBlocks(Pass pass, int colour, int thread, int threads);
   void StoreAnchor(const Constraint& constraint, FrictionAnchor* anchor) const;
-  void Store(const Constraint& constraint, SolverManifold* manifold, FrictionAnchor* anchor) const;
+  // Constraint k's results into its manifold (colouring_.order[k]) and its
+  // friction anchor.
+  void Store(std::size_t k, const Constraint& constraint) const;
 
   std::vector<SoftBody>* bodies_ = nullptr;
+  std::vector<SolverManifold>* manifolds_ = nullptr;
+  std::vector<FrictionAnchor>* anchors_ = nullptr;
   std::vector<State> states_;          // per body of bodies_
   std::vector<std::uint32_t> moving_;  // indices of the moving bodies
+  // In colour order; with lanes only the overflow set's are written, the
+  // blocks holding the others.
   std::vector<Constraint> constraints_;
   ConstraintColouring colouring_;
   std::vector<std::uint32_t> body_a_;  // per constraint, for the colouring

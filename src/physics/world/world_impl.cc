@@ -321,7 +321,7 @@ void WorldImpl::Step() {
   profile.broad_phase_ms = lap();
   UpdateNarrowPhase(step);
   profile.narrow_phase_ms = lap();
-  UpdateContactCache(step);
+  UpdateContactCache();
   profile.contact_cache_ms = lap();
   motion_solver_->Solve(step);
   profile.solver_ms = lap();

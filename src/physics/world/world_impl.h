@@ -112,9 +112,9 @@ class WorldImpl : public LinkBodies {
   void WakeTouching(std::uint32_t body);
 
   // The stages of Step, in order, one file each (step_*.cc).
-  void UpdateBroadPhase(const StepContext& step);    // 1. broad phase: swept boxes, candidate pairs
-  void UpdateNarrowPhase(const StepContext& step);   // 2. narrow phase: manifolds per shape pair
-  void UpdateContactCache(const StepContext& step);  // 3. contact cache: witnesses, warm starts
+  void UpdateBroadPhase(const StepContext& step);   // 1. broad phase: swept boxes, candidate pairs
+  void UpdateNarrowPhase(const StepContext& step);  // 2. narrow phase: manifolds per shape pair
+  void UpdateContactCache();  // 3. contact cache: pruned, touching pairs listed
   // 4 and 5, from velocities to poses, are motion_solver_'s (solver/).
   // The awake, enabled bodies that are not links into moving_bodies_.
   void ListMovingBodies();
