@@ -27,6 +27,19 @@ constexpr double kMarginPerThickness = 0.25;
 // that a chunk of clipped pairs among carried ones evens out.
 constexpr std::size_t kJobsPerChunk = 32;
 
+// Broad-phase pairs a thread visits at a time (VisitPair, about 50 ns each).
+constexpr std::size_t kVisitsPerChunk = 256;
+
+// Records a shape pair's contact distance, and says whether its gap cannot
+// have closed to it since the gap was found (conservative advancement's
+// bound, kept across steps): such a pair is culled, with no points to match.
+bool CullPair(ShapePairContact* entry, double contact_distance, double travel) {
+  entry->contact_distance = contact_distance;
+  if (!(entry->apart_gap - (travel - entry->apart_travel) > contact_distance)) return false;
+  MatchCulled(entry);
+  return true;
+}
+
 // Puts the moving body of a pair first when only one moves, so that normals
 // point from the static or sleeping body B into A (CollideBodies).
 void MovingBodyFirst(const std::vector<Body>& bodies, std::uint32_t* body_a,
@@ -54,11 +67,7 @@ void CollideMeshSlots(const MeshVisit& visit, const ConvexMeshPair& pair) {
   ShapePairContact& first =
       visit.cache->Touch(visit.body_a, visit.shape_a, visit.body_b,
                          static_cast<std::uint16_t>(visit.shape_b), visit.step);
-  first.contact_distance = pair.contact_distance;
-  if (first.apart_gap - (visit.travel - first.apart_travel) > pair.contact_distance) {
-    MatchCulled(&first);
-    return;
-  }
+  if (CullPair(&first, pair.contact_distance, visit.travel)) return;
   thread_local MeshContacts contacts;
   CollideConvexMesh(pair, &contacts);
   for (int slot = 0; slot < StaticMesh::kContactSlots; ++slot) {
@@ -97,13 +106,17 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
   for (std::size_t k = 0; k < std::min(pairs.size(), kSlotPrefetchAhead); ++k) {
     prefetch(ContactCache::Prefetch::kSlot, k);
   }
-  narrow_jobs_.clear();
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
+  // The pairs are visited on the pool, where each finds and updates its own
+  // cache entry; then listed in their order, which creates the missing
+  // entries and orders the visits and the jobs as a walk on one thread.
+  pair_visits_.resize(pairs.size());
+  step.pool->ParallelFor(pairs.size(), kVisitsPerChunk, [&](std::size_t k) {
     prefetch(ContactCache::Prefetch::kSlot, k + kSlotPrefetchAhead);
     prefetch(ContactCache::Prefetch::kEntry, k + kEntryPrefetchAhead);
-    CollideBodies(static_cast<std::uint32_t>(pairs[k].first),
-                  static_cast<std::uint32_t>(pairs[k].second), step);
-  }
+    VisitPair(pairs[k], step, &pair_visits_[k]);
+  });
+  narrow_jobs_.clear();
+  for (std::size_t k = 0; k < pairs.size(); ++k) ListPair(pairs[k], pair_visits_[k], step);
   for (const std::uint32_t plane : half_space_bodies_) {
     const Pose world_from_plane =
         bodies_[plane].WorldFromBody() * bodies_[plane].shapes.front().body_from_shape;
@@ -264,12 +277,61 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const 
       }
       ShapePairContact& entry = contact_cache_.Touch(body_a, static_cast<std::uint16_t>(i), body_b,
                                                      static_cast<std::uint16_t>(k), step_count_);
-      entry.contact_distance = contact_distance;
-      if (entry.apart_gap - (travel - entry.apart_travel) > contact_distance) {
-        MatchCulled(&entry);
-        continue;
+      if (!CullPair(&entry, contact_distance, travel)) {
+        narrow_jobs_.push_back({&entry, travel, false});
       }
-      narrow_jobs_.push_back({&entry, travel, false});
+    }
+  }
+}
+
+// CollideBodies' work on a pair of single convex shapes whose entry exists:
+// it reads the bodies and writes only that entry.
+void WorldImpl::VisitPair(ProxyPair pair, const StepContext& step, PairVisit* visit) {
+  *visit = PairVisit();
+  auto body_a = static_cast<std::uint32_t>(pair.first);
+  auto body_b = static_cast<std::uint32_t>(pair.second);
+  MovingBodyFirst(bodies_, &body_a, &body_b);
+  const Body& a = bodies_[body_a];
+  const Body& b = bodies_[body_b];
+  if (articulations_.SkipsPair(a, b)) return;
+  if (a.shapes.size() != 1 || b.shapes.size() != 1 ||
+      std::holds_alternative<StaticMesh>(b.shapes.front().geometry)) {
+    visit->kind = PairVisit::Kind::kInWalk;
+    return;
+  }
+  visit->body_a = body_a;
+  visit->body_b = body_b;
+  visit->contact_distance = ContactMargin(a, b) + ContactReach(a, b, step);
+  visit->travel = a.travel + b.travel;
+  visit->entry = contact_cache_.Find(body_a, 0, body_b, 0);
+  if (visit->entry == nullptr) {
+    visit->kind = PairVisit::Kind::kNew;
+    return;
+  }
+  visit->kind = PairVisit::Kind::kSeen;
+  visit->first_visit = ContactCache::MarkSeen(visit->entry, step_count_);
+  visit->culled = CullPair(visit->entry, visit->contact_distance, visit->travel);
+}
+
+// What the walk on one thread does with a visited pair, in the pairs' order.
+void WorldImpl::ListPair(ProxyPair pair, const PairVisit& visit, const StepContext& step) {
+  switch (visit.kind) {
+    case PairVisit::Kind::kSkipped:
+      return;
+    case PairVisit::Kind::kInWalk:
+      CollideBodies(static_cast<std::uint32_t>(pair.first), static_cast<std::uint32_t>(pair.second),
+                    step);
+      return;
+    case PairVisit::Kind::kSeen:
+      if (visit.first_visit) contact_cache_.ListVisit(visit.entry);
+      if (!visit.culled) narrow_jobs_.push_back({visit.entry, visit.travel, false});
+      return;
+    case PairVisit::Kind::kNew: {
+      ShapePairContact& entry = contact_cache_.Touch(visit.body_a, 0, visit.body_b, 0, step_count_);
+      if (!CullPair(&entry, visit.contact_distance, visit.travel)) {
+        narrow_jobs_.push_back({&entry, visit.travel, false});
+      }
+      return;
     }
   }
 }

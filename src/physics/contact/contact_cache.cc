@@ -99,9 +99,13 @@ ShapePairContact& ContactCache::Touch(std::uint32_t body_a, std::uint16_t shape_
     // Map nodes do not move, so the pointer stays good until the pair is erased.
     index_.Insert(key, entry);
   }
-  if (entry->last_seen_step != step) visited_.push_back(entry);
-  entry->last_seen_step = step;
+  if (MarkSeen(entry, step)) ListVisit(entry);
   return *entry;
+}
+
+ShapePairContact* ContactCache::Find(std::uint32_t body_a, std::uint16_t shape_a,
+                                     std::uint32_t body_b, std::uint16_t shape_b) const {
+  return index_.Find(Key(body_a, shape_a, body_b, shape_b));
 }
 
 void ContactCache::Prune(std::uint64_t step, bool recheck_frozen,

@@ -137,6 +137,19 @@ class ContactCache {
   // The entry of a shape pair, created empty when new; marks it seen.
   ShapePairContact& Touch(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
                           std::uint16_t shape_b, std::uint64_t step);
+  // Touch of a pair that has an entry, in two halves so that the first may
+  // run on any thread while nothing creates entries: Find gives the entry
+  // (null when there is none, or it is frozen); MarkSeen marks it seen in
+  // `step` and says whether that is its first visit of the step, which the
+  // caller then lists with ListVisit in its walk's order.
+  ShapePairContact* Find(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
+                         std::uint16_t shape_b) const;
+  static bool MarkSeen(ShapePairContact* entry, std::uint64_t step) {
+    const bool first = entry->last_seen_step != step;
+    entry->last_seen_step = step;
+    return first;
+  }
+  void ListVisit(ShapePairContact* entry) { visited_.push_back(entry); }
   // Each pair the narrow phase touches has its points matched with last
   // step's (MatchWarmStarts) once its manifold is final, while the entry is
   // in the cache. Stage 3 in two parts: Prune drops the pairs not seen in

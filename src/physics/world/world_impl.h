@@ -42,6 +42,23 @@ struct NarrowJob {
   bool reused = false;  // the manifold was carried, not clipped (out)
 };
 
+// A broad-phase pair as the narrow phase's walk first sees it, on any
+// thread (WorldImpl::VisitPair), and what the walk in the pairs' order then
+// does with it (ListPair). Only a pair of two single-shape bodies, neither a
+// static mesh, whose shape pair has a cache entry is handled on the pool;
+// the rest are listed by CollideBodies in the ordered walk.
+struct PairVisit {
+  enum class Kind : std::uint8_t { kSkipped, kInWalk, kSeen, kNew };
+  Kind kind = Kind::kSkipped;
+  bool first_visit = false;  // kSeen: the entry's first visit of the step
+  bool culled = false;       // kSeen: its gap cannot have closed
+  std::uint32_t body_a = 0;  // kSeen, kNew: the moving body first
+  std::uint32_t body_b = 0;
+  ShapePairContact* entry = nullptr;  // kSeen's
+  double contact_distance = 0.0;      // m, kSeen's and kNew's
+  double travel = 0.0;                // m, Body::travel of both
+};
+
 // The public methods do what World's of the same name are documented to do.
 class WorldImpl : public LinkBodies {
  public:
@@ -132,6 +149,9 @@ class WorldImpl : public LinkBodies {
   // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
   // a static mesh's are tested at once.
   void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const StepContext& step);
+  // CollideBodies in two halves for a pair of single shapes (PairVisit).
+  void VisitPair(ProxyPair pair, const StepContext& step, PairVisit* visit);
+  void ListPair(ProxyPair pair, const PairVisit& visit, const StepContext& step);
   // Tests one listed shape pair: carries its manifold or clips a new one.
   void CollideShapePair(NarrowJob* job) const;
   double ContactDistance(const Body& a, const Body& b, const StepContext& step) const;
@@ -164,6 +184,7 @@ class WorldImpl : public LinkBodies {
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
   std::unique_ptr<MotionSolver> motion_solver_;  // settings_.motion_solver
+  std::vector<PairVisit> pair_visits_;           // stage 2's, per broad-phase pair
   std::vector<NarrowJob> narrow_jobs_;           // stage 2's, in the order the pairs were visited
   std::vector<Body> bodies_;                     // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
