@@ -184,25 +184,16 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
     const bool shown = point.type == ContactType::kColliding ? collided : touching;
     return shown && (!impacts_only || collided);
   };
-  // On the pool: each pair keeps its points for the next step's warm start
-  // and counts its reports; their offsets in contacts_ follow, in manifold
-  // order; then each pair writes its reports there.
+  // On the pool: each manifold counts its reports (from its solver points
+  // alone); their offsets in contacts_ follow, in manifold order; then each
+  // pair keeps its points for the next step's warm start and writes its
+  // reports at its offset, its entry loaded once.
   const std::size_t count = manifolds.size();
   report_offsets_.assign(count + 1, 0);
   step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
-    PrefetchAhead(pairs, m, PrefetchPoints);
     const SolverManifold& manifold = manifolds[m];
-    ShapePairContact& pair = *pairs[m];
-    pair.previous_count = manifold.point_count;
     std::uint32_t reports = 0;
-    for (int i = 0; i < manifold.point_count; ++i) {
-      const SolverPoint& point = manifold.points[i];
-      pair.previous[i] =
-          CachedImpulse{point.feature,         point.normal_impulse,
-                        point.tangent_impulse, pair.manifold.points[i].position_world,
-                        point.preload,         point.carried_approach};
-      reports += reported(point) ? 1 : 0;
-    }
+    for (int i = 0; i < manifold.point_count; ++i) reports += reported(manifold.points[i]) ? 1 : 0;
     report_offsets_[m + 1] = reports;
   });
   report_offsets_[0] = static_cast<std::uint32_t>(contacts_.size());
@@ -210,11 +201,17 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
   const std::size_t first_report = contacts_.size();
   contacts_.resize(report_offsets_[count]);
   step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
+    PrefetchAhead(pairs, m, PrefetchPoints);
     const SolverManifold& manifold = manifolds[m];
-    const ShapePairContact& pair = *pairs[m];
+    ShapePairContact& pair = *pairs[m];
+    pair.previous_count = manifold.point_count;
     std::uint32_t next = report_offsets_[m];
     for (int i = 0; i < manifold.point_count; ++i) {
       const SolverPoint& point = manifold.points[i];
+      pair.previous[i] =
+          CachedImpulse{point.feature,         point.normal_impulse,
+                        point.tangent_impulse, pair.manifold.points[i].position_world,
+                        point.preload,         point.carried_approach};
       if (!reported(point)) continue;
       ContactReport& report = contacts_[next++];
       report = MakeReport(pair, i, manifold.tangent_world, step);
