@@ -130,8 +130,9 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     // overflow set.
     const std::size_t first_scalar = blocks_.empty() ? 0 : colouring_.colour_start.back();
     const auto [begin, end] = Share(constraints_.size() - first_scalar, thread, threads);
-    for (std::size_t k = first_scalar + begin; k < first_scalar + end; ++k)
+    for (std::size_t k = first_scalar + begin; k < first_scalar + end; ++k) {
       Store(k, constraints_[k]);
+    }
     const auto [first, last] = Share(moving_.size(), thread, threads);
     for (std::size_t k = first; k < last; ++k) {
       SoftBody& body = (*bodies)[moving_[k]];
