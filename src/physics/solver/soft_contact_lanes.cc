@@ -11,7 +11,7 @@ void SetLane(const Vec3& v, int lane, LaneDoubles (&lanes)[3]) {
   for (int axis = 0; axis < 3; ++axis) lanes[axis][lane] = v[axis];
 }
 
-void PackPoint(const SoftPoint& from, int lane, SoftLanePoint* to) {
+void PackPoint(const SoftPoint& from, int lane, SoftLanePoint* to, LaneMask* carried) {
   SetLane(from.rn_a, lane, to->rn_a);
   SetLane(from.rn_b, lane, to->rn_b);
   SetLane(from.ang_a, lane, to->ang_a);
@@ -24,22 +24,20 @@ void PackPoint(const SoftPoint& from, int lane, SoftLanePoint* to) {
   to->total_normal_impulse[lane] = from.total_normal_impulse;
   to->approach_velocity[lane] = from.approach_velocity;
   to->closed[lane] = from.closed ? -1 : 0;
-  to->carried[lane] = from.carried ? -1 : 0;
+  (*carried)[lane] = from.carried ? -1 : 0;
 }
 
 void PackFriction(const SoftConstraint& c, int lane, SoftLaneBlock* block) {
   for (int k = 0; k < 2; ++k) {
     SetLane(c.tangent[k], lane, block->tangent[k]);
-    SetLane(c.ct_a[k], lane, block->ct_a[k]);
-    SetLane(c.ct_b[k], lane, block->ct_b[k]);
     SetLane(c.ang_t_a[k], lane, block->ang_t_a[k]);
     SetLane(c.ang_t_b[k], lane, block->ang_t_b[k]);
-    SetLane(c.anchor_t_a[k], lane, block->anchor_t_a[k]);
-    SetLane(c.anchor_t_b[k], lane, block->anchor_t_b[k]);
     block->slip_start[k][lane] = c.slip_start[k];
     block->tangent_impulse[k][lane] = c.tangent_impulse[k];
     block->total_tangent_impulse[k][lane] = c.total_tangent_impulse[k];
   }
+  SetLane(c.centre_a, lane, block->centre_a);
+  SetLane(c.centre_b, lane, block->centre_b);
   SetLane(c.twist_a, lane, block->twist_a);
   SetLane(c.twist_b, lane, block->twist_b);
   for (int k = 0; k < 3; ++k) block->tangent_block[k][lane] = c.tangent_block[k];
@@ -112,6 +110,15 @@ template <bool kMotion>
   *out = along + turn_a - turn_b;
 }
 
+// a x b, with Eigen's cross's operations in its order (so a lane gives
+// the bits that the scalar rows' precomputed products hold).
+[[gnu::always_inline]] inline void Cross(const LaneDoubles (&a)[3], const LaneDoubles (&b)[3],
+                                         LaneDoubles (&out)[3]) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 // PairVelocities::Apply in the lanes of `on`: impulse p on A, -p on B,
 // their turns given.
 [[gnu::always_inline]] inline void Apply(const LaneMask& on, const LaneDoubles (&p)[3],
@@ -131,15 +138,16 @@ template <bool kMotion>
 
 // The normal impulse `impulse` of point `p` applied (WarmStart's and the
 // solve's push along n).
-[[gnu::always_inline]] inline void ApplyNormal(const SoftLaneBlock& c, const SoftLanePoint& p,
+[[gnu::always_inline]] inline void ApplyNormal(const SoftLaneBlock& c, int i,
                                                const LaneDoubles& impulse, LaneBodies* v) {
+  const SoftLanePoint& p = c.points[i];
   LaneDoubles push[3], turn_a[3], turn_b[3];
   for (int axis = 0; axis < 3; ++axis) {
     push[axis] = impulse * c.normal[axis];
     turn_a[axis] = impulse * p.ang_a[axis];
     turn_b[axis] = impulse * p.ang_b[axis];
   }
-  Apply(p.present, push, c, turn_a, turn_b, v);
+  Apply(c.point_count > i, push, c, turn_a, turn_b, v);
 }
 
 [[gnu::always_inline]] inline void WarmStartBlock(const SoftLaneContext& context,
@@ -147,7 +155,7 @@ template <bool kMotion>
   LaneBodies v;
   Gather</*kMotion=*/false>(c, *context.states, &v);
   for (int i = 0; i < c.max_points; ++i) {
-    ApplyNormal(c, c.points[i], c.points[i].normal_impulse, &v);
+    ApplyNormal(c, i, c.points[i].normal_impulse, &v);
   }
   const LaneDoubles(&t)[2] = c.tangent_impulse;
   LaneDoubles push[3], turn_a[3], turn_b[3];
@@ -183,7 +191,8 @@ template <bool kMotion>
     separation[i] = p.start_separation + moved + turn_a - turn_b;
     LaneDoubles vn;
     Along(v, c->normal, p.rn_a, p.rn_b, &vn);
-    const LaneMask closing = p.present & ~p.closed & (separation[i] + h * vn <= LaneDoubles{});
+    const LaneMask closing =
+        (c->point_count > i) & ~p.closed & (separation[i] + h * vn <= LaneDoubles{});
     p.closed |= closing;
     p.approach_velocity = closing ? vn : p.approach_velocity;
     fast |= closing & (vn < threshold);
@@ -198,21 +207,29 @@ template <bool kMotion>
   LaneDoubles normal = {};
   for (int i = 0; i < c->max_points; ++i) {
     const SoftLanePoint& p = c->points[i];
-    normal = p.present ? normal + p.normal_impulse : normal;
+    normal = (c->point_count > i) ? normal + p.normal_impulse : normal;
   }
   const LaneDoubles limit = c->friction * normal;
   LaneDoubles velocity[2];
-  for (int k = 0; k < 2; ++k) Along(*v, c->tangent[k], c->ct_a[k], c->ct_b[k], &velocity[k]);
+  for (int k = 0; k < 2; ++k) {
+    LaneDoubles ct_a[3], ct_b[3];
+    Cross(c->centre_a, c->tangent[k], ct_a);
+    Cross(c->centre_b, c->tangent[k], ct_b);
+    Along(*v, c->tangent[k], ct_a, ct_b, &velocity[k]);
+  }
   LaneDoubles mass_scale = LaneDoubles{} + 1.0;
   LaneDoubles impulse_scale = {};
   if (use_bias) {
     LaneDoubles dx[3];
     for (int axis = 0; axis < 3; ++axis) dx[axis] = v->dx_a[axis] - v->dx_b[axis];
     for (int k = 0; k < 2; ++k) {
+      LaneDoubles anchor_t_a[3], anchor_t_b[3];
+      Cross(c->anchor_a, c->tangent[k], anchor_t_a);
+      Cross(c->anchor_b, c->tangent[k], anchor_t_b);
       LaneDoubles along, turn_a, turn_b;
       Dot(c->tangent[k], dx, &along);
-      Dot(c->anchor_t_a[k], v->dtheta_a, &turn_a);
-      Dot(c->anchor_t_b[k], v->dtheta_b, &turn_b);
+      Dot(anchor_t_a, v->dtheta_a, &turn_a);
+      Dot(anchor_t_b, v->dtheta_b, &turn_b);
       const LaneDoubles slip = c->slip_start[k] + along + turn_a - turn_b;
       velocity[k] += c->bias_rate * slip;
     }
@@ -303,17 +320,18 @@ template <bool kMotion>
     const LaneDoubles sum = p.normal_impulse + change;
     const LaneDoubles next = sum < zero ? zero : sum;
     const LaneDoubles applied = next - p.normal_impulse;
-    p.normal_impulse = p.present ? next : p.normal_impulse;
+    const LaneMask present = c->point_count > i;
+    p.normal_impulse = present ? next : p.normal_impulse;
     const LaneDoubles larger = p.max_normal_impulse < applied ? applied : p.max_normal_impulse;
-    p.max_normal_impulse = p.present ? larger : p.max_normal_impulse;
-    ApplyNormal(*c, p, applied, &v);
+    p.max_normal_impulse = present ? larger : p.max_normal_impulse;
+    ApplyNormal(*c, i, applied, &v);
   }
   SolveFrictionLanes(use_bias, c, &v);
   if (!use_bias) {
     for (int i = 0; i < c->max_points; ++i) {
       SoftLanePoint& p = c->points[i];
       const LaneDoubles total = p.total_normal_impulse + p.normal_impulse;
-      p.total_normal_impulse = p.present ? total : p.total_normal_impulse;
+      p.total_normal_impulse = (c->point_count > i) ? total : p.total_normal_impulse;
     }
     c->total_tangent_impulse[0] += c->tangent_impulse[0];
     c->total_tangent_impulse[1] += c->tangent_impulse[1];
@@ -332,11 +350,7 @@ void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int l
   block->lanes = lanes;
   block->max_points = 0;
   for (int lane = 0; lane < kBatchLanes; ++lane) {
-    const int points = lane < lanes ? constraints[lane].point_count : 0;
-    block->point_count[lane] = points;
-    for (int i = 0; i < ContactManifold::kMaxPoints; ++i) {
-      block->points[i].present[lane] = i < points ? -1 : 0;
-    }
+    block->point_count[lane] = lane < lanes ? constraints[lane].point_count : 0;
   }
   for (int lane = 0; lane < kBatchLanes; ++lane) {
     // A lane without a constraint reads the first lane's bodies, and is
@@ -361,7 +375,9 @@ void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int l
     SetLane(c.anchor_a, lane, block->anchor_a);
     SetLane(c.anchor_b, lane, block->anchor_b);
     PackFriction(c, lane, block);
-    for (int i = 0; i < c.point_count; ++i) PackPoint(c.points[i], lane, &block->points[i]);
+    for (int i = 0; i < c.point_count; ++i) {
+      PackPoint(c.points[i], lane, &block->points[i], &block->carried[i]);
+    }
   }
 }
 
@@ -380,7 +396,7 @@ void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
     c.restitution = block.restitution[lane];
   }
   c.friction = block.friction[lane];
-  c.point_count = block.point_count[lane];
+  c.point_count = static_cast<int>(block.point_count[lane]);
   c.anchor_a = get(block.anchor_a);
   c.anchor_b = get(block.anchor_b);
   for (int k = 0; k < 2; ++k) {
@@ -406,7 +422,7 @@ void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
     p.total_normal_impulse = from.total_normal_impulse[lane];
     p.approach_velocity = from.approach_velocity[lane];
     p.closed = from.closed[lane] != 0;
-    p.carried = from.carried[lane] != 0;
+    p.carried = block.carried[i][lane] != 0;
     p.touched = false;
   }
 }

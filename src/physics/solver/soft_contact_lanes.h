@@ -36,8 +36,6 @@ struct SoftLanePoint {
   LaneDoubles total_normal_impulse;
   LaneDoubles approach_velocity;  // m/s
   LaneMask closed;
-  LaneMask present;  // the lane's manifold has this point
-  LaneMask carried;  // read only after the sub-steps
 };
 
 // Up to four constraints of one colour in structure-of-arrays form: the
@@ -58,8 +56,14 @@ struct SoftLaneBlock {
   LaneDoubles bias_rate;
   LaneDoubles mass_scale;
   LaneDoubles impulse_scale;
-  LaneDoubles ct_a[2][3];
-  LaneDoubles ct_b[2][3];
+  // The centroid c of each body's points and the friction anchors, from
+  // which the lanes form c x t_k and anchor x t_k as they go (Cross): a
+  // smaller block, as the sub-steps stream every block a pass and the big
+  // scenes' blocks outgrow the cache.
+  LaneDoubles centre_a[3];
+  LaneDoubles centre_b[3];
+  LaneDoubles anchor_a[3];
+  LaneDoubles anchor_b[3];
   LaneDoubles ang_t_a[2][3];
   LaneDoubles ang_t_b[2][3];
   LaneDoubles twist_a[3];
@@ -68,17 +72,14 @@ struct SoftLaneBlock {
   LaneDoubles twist_mass;
   LaneDoubles twist_arm;
   LaneDoubles slip_start[2];
-  LaneDoubles anchor_t_a[2][3];
-  LaneDoubles anchor_t_b[2][3];
   LaneDoubles tangent_impulse[2];
   LaneDoubles twist_impulse;
   LaneDoubles total_tangent_impulse[2];
+  LaneMask point_count;  // a lane's point i is present where i < point_count
   std::array<SoftLanePoint, ContactManifold::kMaxPoints> points;
   // Read only after the sub-steps, by the restitution pass and the store.
-  std::array<int, kBatchLanes> point_count;
   LaneDoubles restitution;
-  LaneDoubles anchor_a[3];
-  LaneDoubles anchor_b[3];
+  LaneMask carried[ContactManifold::kMaxPoints];
 };
 
 // What the lane updates read besides the blocks.

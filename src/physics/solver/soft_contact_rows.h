@@ -73,6 +73,8 @@ struct SoftConstraint {
   // anchor x t_k for its change with the bodies' turn.
   Vec3 anchor_a;
   Vec3 anchor_b;
+  Vec3 centre_a;  // m, c_a (the lanes form c_a x t_k from it)
+  Vec3 centre_b;
   std::array<double, 2> slip_start;
   std::array<Vec3, 2> anchor_t_a;
   std::array<Vec3, 2> anchor_t_b;

@@ -234,6 +234,8 @@ void SoftContactSolver::PrepareFriction(const SoftBody& a, const SoftBody& b,
     const Vec3 offset = manifold.points[i].r_a - centre_a;
     c->twist_arm += inverse_count * (offset - offset.dot(c->normal) * c->normal).norm();
   }
+  c->centre_a = centre_a;
+  c->centre_b = centre_b;
   c->anchor_a = anchor.valid ? a.orientation * anchor.on_a : centre_a;
   c->anchor_b = anchor.valid ? b.orientation * anchor.on_b : centre_b;
   const Vec3 anchors_apart = a.position + c->anchor_a - b.position - c->anchor_b;
