@@ -193,7 +193,7 @@ bench: deps
 	  -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" > /dev/null
 	cmake --build $(BENCH_BUILD) -j$(JOBS) \
 	  --target physics_bench hull_bench narrow_phase_bench broad_phase_bench chain_scaling_bench \
-	  ray_bench
+	  ray_bench soft_lanes_bench
 	mkdir -p $(ROOT)/bench/results
 	@echo "[bench] $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $$(date -u '+%F %H:%M UTC')"
 	$(BENCH_BUILD)/physics_bench --runs $(BENCH_RUNS) --scale $(BENCH_SCALE) \
@@ -207,6 +207,7 @@ bench: deps
 	  python3 $(ROOT)/bench/ray_service_bench.py --client $(WS)/devel/lib/rigid_body_sim/ray_service_client; \
 	else echo "spawn: node not built ($(WS)/devel/lib/rigid_body_sim/rigid_body_sim_node; make build)"; fi
 	$(BENCH_BUILD)/narrow_phase_bench 200000
+	$(BENCH_BUILD)/soft_lanes_bench
 	$(BENCH_BUILD)/broad_phase_bench 30
 	$(BENCH_BUILD)/chain_scaling_bench 480
 	$(BENCH_BUILD)/ray_bench 100000
