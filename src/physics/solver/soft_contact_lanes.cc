@@ -136,7 +136,7 @@ template <bool kMotion>
   }
 }
 
-// The normal impulse `impulse` of point `p` applied (WarmStart's and the
+// The normal impulse `impulse` of point i applied (WarmStart's and the
 // solve's push along n).
 [[gnu::always_inline]] inline void ApplyNormal(const SoftLaneBlock& c, int i,
                                                const LaneDoubles& impulse, LaneBodies* v) {
@@ -207,7 +207,7 @@ template <bool kMotion>
   LaneDoubles normal = {};
   for (int i = 0; i < c->max_points; ++i) {
     const SoftLanePoint& p = c->points[i];
-    normal = (c->point_count > i) ? normal + p.normal_impulse : normal;
+    normal = c->point_count > i ? normal + p.normal_impulse : normal;
   }
   const LaneDoubles limit = c->friction * normal;
   LaneDoubles velocity[2];
@@ -331,7 +331,7 @@ template <bool kMotion>
     for (int i = 0; i < c->max_points; ++i) {
       SoftLanePoint& p = c->points[i];
       const LaneDoubles total = p.total_normal_impulse + p.normal_impulse;
-      p.total_normal_impulse = (c->point_count > i) ? total : p.total_normal_impulse;
+      p.total_normal_impulse = c->point_count > i ? total : p.total_normal_impulse;
     }
     c->total_tangent_impulse[0] += c->tangent_impulse[0];
     c->total_tangent_impulse[1] += c->tangent_impulse[1];
