@@ -3,6 +3,14 @@
 // of them have finished it. The stages hand it work whose result does not
 // depend on which thread does which part (each part writes only its own
 // outputs), so a step's result is the same for any number of threads.
+//
+// A step hands the pool a dozen tasks, microseconds to a millisecond apart.
+// Waking a blocked thread costs tens of microseconds on a virtual machine
+// (a futex call, then the scheduler), as much as a small stage's work; so a
+// worker spins for a new task for kWorkerSpin after each one, and the
+// caller spins for the workers to finish, before either blocks. Between
+// steps (a node stepping in real time waits most of its period) the
+// workers block, so an idle world costs no core.
 #ifndef RIGID_BODY_SIM_PHYSICS_WORLD_TASK_POOL_H_
 #define RIGID_BODY_SIM_PHYSICS_WORLD_TASK_POOL_H_
 
@@ -55,15 +63,25 @@ class TaskPool {
 
  private:
   void WorkerLoop(int index);
+  // Blocks until a task newer than `seen`, or stop_; returns false on stop_.
+  bool AwaitTask(std::uint64_t seen);
+  // Returns when every worker has finished the current task.
+  void AwaitWorkers();
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable start_;  // a new task, or stop_
   std::condition_variable done_;   // pending_ reached 0
   const std::function<void(int)>* task_ = nullptr;
-  std::uint64_t generation_ = 0;  // counts the tasks handed out
-  int pending_ = 0;               // workers still running the current task
-  bool stop_ = false;
+  // generation_'s release store publishes task_ and pending_.
+  std::atomic<std::uint64_t> generation_{0};  // counts the tasks handed out
+  std::atomic<int> pending_{0};               // workers still running the current task
+  // Threads that stopped spinning and block, or are about to: a waker
+  // reads them after its own store (both sequentially consistent), so one
+  // of the two sides always sees the other.
+  std::atomic<int> sleeping_workers_{0};
+  std::atomic<bool> caller_sleeping_{false};
+  std::atomic<bool> stop_{false};
 };
 
 // The threads a `threads` setting asks for: itself, or for 0 every core the
