@@ -8,7 +8,9 @@
 // Each block's lanes join random pairs of twice as many bodies as blocks
 // (moving, unit mass and inertia), resting 1 mm deep on their normal, so
 // that the solve's every branch runs and the velocities stay finite. The
-// passes alternate solve and relax, as the sub-steps do.
+// passes alternate solve and relax, as the sub-steps do. Each count is timed
+// with wide blocks (doubles) and compact ones (what the passes only read in
+// floats: SoftStepSettings::compact_blocks_from picks between them).
 //
 // Usage: soft_lanes_bench [passes over 1,000 blocks]   (default 400)
 #include <algorithm>
@@ -72,12 +74,13 @@ struct Timing {
   double solve_ns;
 };
 
+template <typename Block>
 Timing TimeBlocks(int block_count, int passes) {
   const std::uint32_t bodies = 2 * static_cast<std::uint32_t>(block_count);
   std::vector<SoftRowState> states(
       bodies, SoftRowState{Vec3(0.0, 0.0, -0.01), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
   const std::vector<std::uint8_t> moving(bodies, 1);
-  std::vector<SoftLaneBlock> blocks(block_count);
+  std::vector<Block> blocks(block_count);
   std::mt19937 random(7);
   for (int b = 0; b < block_count; ++b) {
     SoftConstraint lanes[kBatchLanes];
@@ -93,8 +96,8 @@ Timing TimeBlocks(int block_count, int passes) {
   context.h = 1.0 / 960.0;
   context.max_push_velocity = 3.0;
   context.collision_velocity_threshold = 0.5;
-  SoftLaneBlock* const begin = blocks.data();
-  SoftLaneBlock* const end = begin + block_count;
+  Block* const begin = blocks.data();
+  Block* const end = begin + block_count;
   // Processor time, not wall time, so that other load does not count.
   const std::clock_t start = std::clock();
   for (int pass = 0; pass < passes; ++pass) WarmStartSoftBlocks(context, begin, end);
@@ -108,14 +111,18 @@ Timing TimeBlocks(int block_count, int passes) {
 
 int Main(int argc, char** argv) {
   const int work = argc > 1 ? std::max(1, std::atoi(argv[1])) : 400;
-  std::printf("soft step lane updates, %zu bytes per block of %d contacts\n", sizeof(SoftLaneBlock),
-              kBatchLanes);
-  std::printf("%8s %10s %16s %12s\n", "blocks", "MB", "warm start ns", "solve ns");
-  for (const int block_count : {100, 600, 1500, 3000, 6000}) {
+  std::printf(
+      "soft step lane updates per block of %d contacts: wide blocks %zu bytes, compact %zu\n",
+      kBatchLanes, sizeof(SoftLaneBlock), sizeof(CompactSoftLaneBlock));
+  std::printf("%8s %10s %12s %12s %12s %12s\n", "blocks", "wide MB", "wide warm", "wide solve",
+              "compact warm", "compact solve");
+  for (const int block_count : {100, 600, 1500, 2000, 3000, 6000}) {
     const int passes = std::max(2, work * 1000 / block_count);
-    const Timing timing = TimeBlocks(block_count, passes);
-    std::printf("%8d %10.1f %16.1f %12.1f\n", block_count,
-                1e-6 * block_count * sizeof(SoftLaneBlock), timing.warm_start_ns, timing.solve_ns);
+    const Timing wide = TimeBlocks<SoftLaneBlock>(block_count, passes);
+    const Timing compact = TimeBlocks<CompactSoftLaneBlock>(block_count, passes);
+    std::printf("%8d %10.1f %12.1f %12.1f %12.1f %12.1f\n", block_count,
+                1e-6 * block_count * sizeof(SoftLaneBlock), wide.warm_start_ns, wide.solve_ns,
+                compact.warm_start_ns, compact.solve_ns);
   }
   return 0;
 }

@@ -61,13 +61,30 @@ BodyId AddPyramid(World* world, int rows) {
   return top;
 }
 
+// The fidelity tests, with wide blocks (the default for these small
+// scenes) and with compact ones, whose rows keep what the sub-steps only
+// read in floats (SoftStepSettings::compact_blocks_from = 0).
+class SoftStepFidelityTest : public ::testing::TestWithParam<bool> {
+ protected:
+  WorldSettings Settings() const {
+    WorldSettings settings = SoftSettings();
+    if (GetParam()) settings.soft_step.compact_blocks_from = 0;
+    return settings;
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(Blocks, SoftStepFidelityTest, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "Compact" : "Wide";
+                         });
+
 void StepFor(World* world, double seconds) {
   const int steps = static_cast<int>(std::lround(seconds / world->settings().time_step));
   for (int i = 0; i < steps; ++i) world->Step();
 }
 
-TEST(SoftStepTest, BoxRestsOnTheGroundCarryingItsWeight) {
-  World world(SoftSettings());
+TEST_P(SoftStepFidelityTest, BoxRestsOnTheGroundCarryingItsWeight) {
+  World world(Settings());
   const BodyId ground = AddGround(&world, MakeMaterial(0.5, 0.0));
   const BoxSpec spec = RestingBox(2.0);
   const BodyId box = AddBox(&world, spec);
@@ -87,8 +104,8 @@ TEST(SoftStepTest, BoxRestsOnTheGroundCarryingItsWeight) {
 
 // A ball of e = 0.5 dropped from h rises to e^2 h: Newton's law on the
 // speed it hits at, sqrt(2 g h).
-TEST(SoftStepTest, BounceApexIsRestitutionSquaredTimesTheDrop) {
-  World world(SoftSettings());
+TEST_P(SoftStepFidelityTest, BounceApexIsRestitutionSquaredTimesTheDrop) {
+  World world(Settings());
   AddGround(&world, MakeMaterial(0.5, 0.5));
   SphereSpec spec;
   spec.radius = 0.1;
@@ -113,8 +130,8 @@ TEST(SoftStepTest, BounceApexIsRestitutionSquaredTimesTheDrop) {
 // ball fell to: sqrt(2 g h), within 2 g h_s for sub-steps of h_s (the
 // sub-step it closes in is one; symplectic Euler's lead over the parabola,
 // g h_s t / 2 in height at t = 0.45 s, is under another).
-TEST(SoftStepTest, ImpactIsReportedAsCollidingAtItsSpeed) {
-  World world(SoftSettings());
+TEST_P(SoftStepFidelityTest, ImpactIsReportedAsCollidingAtItsSpeed) {
+  World world(Settings());
   const BodyId ground = AddGround(&world, MakeMaterial(0.5, 0.0));
   SphereSpec spec;
   spec.radius = 0.1;
@@ -145,8 +162,8 @@ TEST(SoftStepTest, ImpactIsReportedAsCollidingAtItsSpeed) {
 
 // A box on a 28 degree incline with mu = 0.5 slides a = g (sin t - mu cos t)
 // from rest: a t^2 / 2 after t.
-TEST(SoftStepTest, BoxSlidesDownAnInclineAsCoulombSays) {
-  World world(SoftSettings());
+TEST_P(SoftStepFidelityTest, BoxSlidesDownAnInclineAsCoulombSays) {
+  World world(Settings());
   const double angle = 28.0 * M_PI / 180.0;
   Pose world_from_ground;
   world_from_ground.rotation = Quat(Eigen::AngleAxisd(angle, Vec3::UnitY()));
@@ -171,8 +188,8 @@ TEST(SoftStepTest, BoxSlidesDownAnInclineAsCoulombSays) {
 
 // A 1 cm cube at 100 m/s, 42 cm a step, meets a 1 cm wall: the speculative
 // contact stops it at the wall instead of past it.
-TEST(SoftStepTest, BulletDoesNotPassAThinWall) {
-  WorldSettings settings = SoftSettings();
+TEST_P(SoftStepFidelityTest, BulletDoesNotPassAThinWall) {
+  WorldSettings settings = Settings();
   settings.gravity = Vec3::Zero();
   World world(settings);
   BoxSpec wall;
@@ -193,8 +210,8 @@ TEST(SoftStepTest, BulletDoesNotPassAThinWall) {
 
 // A pyramid of unit boxes, as the benchmark's: its top box stays within
 // 1 mm of where it was spawned.
-TEST(SoftStepTest, PyramidStands) {
-  World world(SoftSettings());
+TEST_P(SoftStepFidelityTest, PyramidStands) {
+  World world(Settings());
   constexpr int kRows = 10;
   const BodyId top = AddPyramid(&world, kRows);
   const Vec3 start = world.GetBody(top).position;
@@ -210,8 +227,8 @@ TEST(SoftStepTest, PyramidStands) {
 // on its springs until they balanced that moment: the top of 10 rows sank
 // 0.11 mm in 0.3 s (pyramid_40 0.84 mm, pyramid_90 3 mm). Seeded with
 // loads balanced in moment, nothing moves.
-TEST(SoftStepTest, PyramidSpawnedTouchingHoldsItsTopWhileAwake) {
-  WorldSettings settings = SoftSettings();
+TEST_P(SoftStepFidelityTest, PyramidSpawnedTouchingHoldsItsTopWhileAwake) {
+  WorldSettings settings = Settings();
   settings.sleep.time_to_sleep = 100.0;
   World world(settings);
   constexpr int kRows = 10;
@@ -355,6 +372,13 @@ TEST(SoftStepTest, BadSettingsAreRefusedWithTheirName) {
   settings = SoftSettings();
   settings.soft_step.contact_hertz = std::nan("");
   EXPECT_FALSE(world.SetSettings(settings).ok());
+  settings = SoftSettings();
+  settings.soft_step.compact_blocks_from = -1;
+  const Status compact = world.SetSettings(settings);
+  ASSERT_FALSE(compact.ok());
+  EXPECT_NE(compact.message().find("soft_step.compact_blocks_from -1 must be >= 0"),
+            std::string::npos)
+      << compact.message();
 }
 
 }  // namespace

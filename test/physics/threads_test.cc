@@ -264,13 +264,16 @@ std::vector<BodyId> BuildPyramid(World* world, int rows) {
 
 // Step by step, the soft step with its contacts four at a time in SIMD
 // lanes (SoftStepSettings::simd_lanes) gives every body's state and every
-// contact report of the scalar update, bit for bit.
+// contact report of the scalar update, bit for bit; both step compact from
+// `compact_blocks_from` blocks on (-1: the default).
 void ExpectLanesStepLikeTheScalarUpdate(const std::function<std::vector<BodyId>(World*)>& build,
-                                        int threads, int steps) {
-  WorldSettings scalar_settings = WithThreads(threads, MotionSolverKind::kSoftStep);
+                                        int threads, int steps, int compact_blocks_from = -1) {
+  WorldSettings lane_settings = WithThreads(threads, MotionSolverKind::kSoftStep);
+  if (compact_blocks_from >= 0) lane_settings.soft_step.compact_blocks_from = compact_blocks_from;
+  WorldSettings scalar_settings = lane_settings;
   scalar_settings.soft_step.simd_lanes = false;
   World scalar(scalar_settings);
-  World lanes(WithThreads(threads, MotionSolverKind::kSoftStep));
+  World lanes(lane_settings);
   ASSERT_TRUE(lanes.settings().soft_step.simd_lanes);
   const std::vector<BodyId> scalar_bodies = build(&scalar);
   const std::vector<BodyId> lane_bodies = build(&lanes);
@@ -292,6 +295,18 @@ TEST(ThreadsTest, SoftStepLanesStepLikeTheScalarUpdateOnPiles) {
 
 TEST(ThreadsTest, SoftStepLanesStepLikeTheScalarUpdateOnAPyramid) {
   ExpectLanesStepLikeTheScalarUpdate([](World* world) { return BuildPyramid(world, 12); }, 1, 240);
+}
+
+// Compact blocks (floats for what the sub-steps only read) from the first
+// block on, and from 12 blocks on, which the falling piles cross as their
+// contacts grow: each layout, and the switch between them, gives the
+// scalar update's bits.
+TEST(ThreadsTest, SoftStepCompactLanesStepLikeTheScalarUpdate) {
+  ExpectLanesStepLikeTheScalarUpdate(BuildPiles, 1, 400, /*compact_blocks_from=*/0);
+  ExpectLanesStepLikeTheScalarUpdate(BuildPiles, 2, 200, /*compact_blocks_from=*/0);
+  ExpectLanesStepLikeTheScalarUpdate(BuildPiles, 2, 400, /*compact_blocks_from=*/12);
+  ExpectLanesStepLikeTheScalarUpdate([](World* world) { return BuildPyramid(world, 12); }, 1, 240,
+                                     /*compact_blocks_from=*/0);
 }
 
 }  // namespace

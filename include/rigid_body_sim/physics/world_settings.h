@@ -117,6 +117,15 @@ struct SoftStepSettings {
   // bit the result of one at a time in less time; false updates them one
   // at a time, the reference.
   bool simd_lanes = true;
+  // Blocks, >= 0: from this many blocks of four contacts on (a step's
+  // count, with simd_lanes or without), the step is compact: its blocks keep
+  // what the sub-steps only read in floats (3,008 bytes instead of 4,640),
+  // and the rows, the scalar update's too, hold those values rounded to
+  // floats (a relative 6e-8), so the lanes still give the scalar update's
+  // bits; 0: every step. Past about 2,000 blocks (9 MB of wide blocks) a
+  // wide block's bytes cost more than a compact one's conversions
+  // (docs/performance.md).
+  int compact_blocks_from = 2000;
 };
 
 // The most sub-steps SoftStepSettings::substeps may ask for.

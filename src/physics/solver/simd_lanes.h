@@ -22,6 +22,38 @@ using LaneDoubles = double __attribute__((vector_size(8 * kBatchLanes), aligned(
 using LaneMask =
     std::int64_t __attribute__((vector_size(8 * kBatchLanes), aligned(8 * kBatchLanes)));
 
+// Four floats, one per lane: what a solver only reads, stored at half the
+// size (the soft step's compact blocks, soft_contact_lanes.h). Each widens
+// to a double exactly, so the lanes compute in double with the values that
+// the scalar rows hold rounded the same way.
+using LaneFloats = float __attribute__((vector_size(4 * kBatchLanes), aligned(4 * kBatchLanes)));
+
+// Stored lanes as doubles: widened from floats, copied from doubles.
+[[gnu::always_inline]] inline void Widen(const LaneFloats& f, LaneDoubles* out) {
+  *out = __builtin_convertvector(f, LaneDoubles);
+}
+[[gnu::always_inline]] inline void Widen(const LaneDoubles& d, LaneDoubles* out) { *out = d; }
+
+// (Overloads, not a template: a vector type's alignment attribute is lost
+// in a template argument.)
+[[gnu::always_inline]] inline void Widen(const LaneFloats (&stored)[3], LaneDoubles (&out)[3]) {
+  for (int axis = 0; axis < 3; ++axis) Widen(stored[axis], &out[axis]);
+}
+[[gnu::always_inline]] inline void Widen(const LaneDoubles (&stored)[3], LaneDoubles (&out)[3]) {
+  for (int axis = 0; axis < 3; ++axis) out[axis] = stored[axis];
+}
+
+// What a solver only reads is stored as LaneStored<kCompact>::Type:
+// floats when compact, else doubles.
+template <bool kCompact>
+struct LaneStored {
+  using Type = LaneDoubles;
+};
+template <>
+struct LaneStored<true> {
+  using Type = LaneFloats;
+};
+
 // out = a . b, added left to right as Eigen adds a 3-vector's products.
 [[gnu::always_inline]] inline void Dot(const LaneDoubles (&a)[3], const LaneDoubles (&b)[3],
                                        LaneDoubles* out) {

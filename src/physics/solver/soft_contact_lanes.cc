@@ -4,22 +4,38 @@
 #include <cmath>
 
 namespace rigid_body_sim::physics {
+// The AVX2 clones load the lanes aligned; the vectors keep their alignment
+// through LaneStored (a template argument would lose it).
+static_assert(alignof(SoftLaneBlock) == sizeof(LaneDoubles) &&
+                  alignof(CompactSoftLaneBlock) == sizeof(LaneDoubles),
+              "lane blocks are aligned to a vector");
+static_assert(alignof(decltype(CompactSoftLaneBlock::normal[0])) == sizeof(LaneFloats),
+              "float lanes are aligned to their size");
+
 namespace {
 
-// Lane `lane` of the 3-vectors lanes[axis] set from v.
+// Lane `lane` of the 3-vectors lanes[axis] set from v, which holds floats'
+// values (NarrowToFloat), so exactly.
+void SetLane(double x, int lane, LaneFloats* lanes) { (*lanes)[lane] = static_cast<float>(x); }
+void SetLane(double x, int lane, LaneDoubles* lanes) { (*lanes)[lane] = x; }
+
+void SetLane(const Vec3& v, int lane, LaneFloats (&lanes)[3]) {
+  for (int axis = 0; axis < 3; ++axis) SetLane(v[axis], lane, &lanes[axis]);
+}
 void SetLane(const Vec3& v, int lane, LaneDoubles (&lanes)[3]) {
-  for (int axis = 0; axis < 3; ++axis) lanes[axis][lane] = v[axis];
+  for (int axis = 0; axis < 3; ++axis) SetLane(v[axis], lane, &lanes[axis]);
 }
 
-void PackPoint(const SoftPoint& from, int lane, SoftLanePoint* to, LaneMask* carried) {
+template <typename LanePoint>
+void PackPoint(const SoftPoint& from, int lane, LanePoint* to, LaneMask* carried) {
   SetLane(from.rn_a, lane, to->rn_a);
   SetLane(from.rn_b, lane, to->rn_b);
   SetLane(from.ang_a, lane, to->ang_a);
   SetLane(from.ang_b, lane, to->ang_b);
-  to->start_separation[lane] = from.start_separation;
+  SetLane(from.start_separation, lane, &to->start_separation);
+  SetLane(from.preload, lane, &to->preload);
   to->normal_mass[lane] = from.normal_mass;
   to->normal_impulse[lane] = from.normal_impulse;
-  to->preload[lane] = from.preload;
   to->max_normal_impulse[lane] = from.max_normal_impulse;
   to->total_normal_impulse[lane] = from.total_normal_impulse;
   to->approach_velocity[lane] = from.approach_velocity;
@@ -27,12 +43,13 @@ void PackPoint(const SoftPoint& from, int lane, SoftLanePoint* to, LaneMask* car
   (*carried)[lane] = from.carried ? -1 : 0;
 }
 
-void PackFriction(const SoftConstraint& c, int lane, SoftLaneBlock* block) {
+template <typename Block>
+void PackFriction(const SoftConstraint& c, int lane, Block* block) {
   for (int k = 0; k < 2; ++k) {
     SetLane(c.tangent[k], lane, block->tangent[k]);
     SetLane(c.ang_t_a[k], lane, block->ang_t_a[k]);
     SetLane(c.ang_t_b[k], lane, block->ang_t_b[k]);
-    block->slip_start[k][lane] = c.slip_start[k];
+    SetLane(c.slip_start[k], lane, &block->slip_start[k]);
     block->tangent_impulse[k][lane] = c.tangent_impulse[k];
     block->total_tangent_impulse[k][lane] = c.total_tangent_impulse[k];
   }
@@ -42,7 +59,7 @@ void PackFriction(const SoftConstraint& c, int lane, SoftLaneBlock* block) {
   SetLane(c.twist_b, lane, block->twist_b);
   for (int k = 0; k < 3; ++k) block->tangent_block[k][lane] = c.tangent_block[k];
   block->twist_mass[lane] = c.twist_mass;
-  block->twist_arm[lane] = c.twist_arm;
+  SetLane(c.twist_arm, lane, &block->twist_arm);
   block->twist_impulse[lane] = c.twist_impulse;
 }
 
@@ -55,8 +72,8 @@ struct LaneBodies {
 
 // The velocities, and with kMotion the motion too (the warm start reads no
 // motion).
-template <bool kMotion>
-[[gnu::always_inline]] inline void Gather(const SoftLaneBlock& block,
+template <bool kMotion, typename Block>
+[[gnu::always_inline]] inline void Gather(const Block& block,
                                           const std::vector<SoftRowState>& states,
                                           LaneBodies* bodies) {
   for (int lane = 0; lane < kBatchLanes; ++lane) {
@@ -77,7 +94,8 @@ template <bool kMotion>
 }
 
 // Only the moving bodies of the lanes that hold a constraint are written.
-[[gnu::always_inline]] inline void Scatter(const SoftLaneBlock& block, const LaneBodies& bodies,
+template <typename Block>
+[[gnu::always_inline]] inline void Scatter(const Block& block, const LaneBodies& bodies,
                                            std::vector<SoftRowState>* states) {
   for (int lane = 0; lane < block.lanes; ++lane) {
     if (block.moves_a[lane]) {
@@ -121,8 +139,9 @@ template <bool kMotion>
 
 // PairVelocities::Apply in the lanes of `on`: impulse p on A, -p on B,
 // their turns given.
+template <typename Block>
 [[gnu::always_inline]] inline void Apply(const LaneMask& on, const LaneDoubles (&p)[3],
-                                         const SoftLaneBlock& c, const LaneDoubles (&turn_a)[3],
+                                         const Block& c, const LaneDoubles (&turn_a)[3],
                                          const LaneDoubles (&turn_b)[3], LaneBodies* v) {
   for (int axis = 0; axis < 3; ++axis) {
     const LaneDoubles v_a = v->v_a[axis] + c.inverse_mass_a * p[axis];
@@ -138,33 +157,46 @@ template <bool kMotion>
 
 // The normal impulse `impulse` of point i applied (WarmStart's and the
 // solve's push along n).
-[[gnu::always_inline]] inline void ApplyNormal(const SoftLaneBlock& c, int i,
-                                               const LaneDoubles& impulse, LaneBodies* v) {
-  const SoftLanePoint& p = c.points[i];
+template <typename Block>
+[[gnu::always_inline]] inline void ApplyNormal(const Block& c, int i, const LaneDoubles& impulse,
+                                               LaneBodies* v) {
+  const auto& p = c.points[i];
+  LaneDoubles normal[3], ang_a[3], ang_b[3];
+  Widen(c.normal, normal);
+  Widen(p.ang_a, ang_a);
+  Widen(p.ang_b, ang_b);
   LaneDoubles push[3], turn_a[3], turn_b[3];
   for (int axis = 0; axis < 3; ++axis) {
-    push[axis] = impulse * c.normal[axis];
-    turn_a[axis] = impulse * p.ang_a[axis];
-    turn_b[axis] = impulse * p.ang_b[axis];
+    push[axis] = impulse * normal[axis];
+    turn_a[axis] = impulse * ang_a[axis];
+    turn_b[axis] = impulse * ang_b[axis];
   }
   Apply(c.point_count > i, push, c, turn_a, turn_b, v);
 }
 
-[[gnu::always_inline]] inline void WarmStartBlock(const SoftLaneContext& context,
-                                                  const SoftLaneBlock& c) {
+template <typename Block>
+[[gnu::always_inline]] inline void WarmStartBlock(const SoftLaneContext& context, const Block& c) {
   LaneBodies v;
   Gather</*kMotion=*/false>(c, *context.states, &v);
   for (int i = 0; i < c.max_points; ++i) {
     ApplyNormal(c, i, c.points[i].normal_impulse, &v);
   }
   const LaneDoubles(&t)[2] = c.tangent_impulse;
+  LaneDoubles tangent[2][3], ang_t_a[2][3], ang_t_b[2][3], twist_a[3], twist_b[3];
+  for (int k = 0; k < 2; ++k) {
+    Widen(c.tangent[k], tangent[k]);
+    Widen(c.ang_t_a[k], ang_t_a[k]);
+    Widen(c.ang_t_b[k], ang_t_b[k]);
+  }
+  Widen(c.twist_a, twist_a);
+  Widen(c.twist_b, twist_b);
   LaneDoubles push[3], turn_a[3], turn_b[3];
   for (int axis = 0; axis < 3; ++axis) {
-    push[axis] = t[0] * c.tangent[0][axis] + t[1] * c.tangent[1][axis];
+    push[axis] = t[0] * tangent[0][axis] + t[1] * tangent[1][axis];
     turn_a[axis] =
-        t[0] * c.ang_t_a[0][axis] + t[1] * c.ang_t_a[1][axis] + c.twist_impulse * c.twist_a[axis];
+        t[0] * ang_t_a[0][axis] + t[1] * ang_t_a[1][axis] + c.twist_impulse * twist_a[axis];
     turn_b[axis] =
-        t[0] * c.ang_t_b[0][axis] + t[1] * c.ang_t_b[1][axis] + c.twist_impulse * c.twist_b[axis];
+        t[0] * ang_t_b[0][axis] + t[1] * ang_t_b[1][axis] + c.twist_impulse * twist_b[axis];
   }
   const LaneMask all = LaneMask{} == LaneMask{};
   Apply(all, push, c, turn_a, turn_b, &v);
@@ -174,23 +206,31 @@ template <bool kMotion>
 // Each point's separation now, and a point that would close within this
 // sub-step marked closed with its approach speed (SoftContactSolver::Solve's
 // first loop). Returns whether one closed faster than the threshold.
-[[gnu::always_inline]] inline bool Separations(const SoftLaneContext& context, SoftLaneBlock* c,
+template <typename Block>
+[[gnu::always_inline]] inline bool Separations(const SoftLaneContext& context, Block* c,
                                                const LaneBodies& v, LaneDoubles* separation) {
   LaneDoubles dx[3];
   for (int axis = 0; axis < 3; ++axis) dx[axis] = v.dx_a[axis] - v.dx_b[axis];
+  LaneDoubles normal[3];
+  Widen(c->normal, normal);
   LaneDoubles moved;
-  Dot(c->normal, dx, &moved);
+  Dot(normal, dx, &moved);
   const LaneDoubles h = LaneDoubles{} + context.h;
   const LaneDoubles threshold = LaneDoubles{} - context.collision_velocity_threshold;
   LaneMask fast = {};
   for (int i = 0; i < c->max_points; ++i) {
-    SoftLanePoint& p = c->points[i];
+    auto& p = c->points[i];
+    LaneDoubles rn_a[3], rn_b[3];
+    Widen(p.rn_a, rn_a);
+    Widen(p.rn_b, rn_b);
     LaneDoubles turn_a, turn_b;
-    Dot(p.rn_a, v.dtheta_a, &turn_a);
-    Dot(p.rn_b, v.dtheta_b, &turn_b);
-    separation[i] = p.start_separation + moved + turn_a - turn_b;
+    Dot(rn_a, v.dtheta_a, &turn_a);
+    Dot(rn_b, v.dtheta_b, &turn_b);
+    LaneDoubles start;
+    Widen(p.start_separation, &start);
+    separation[i] = start + moved + turn_a - turn_b;
     LaneDoubles vn;
-    Along(v, c->normal, p.rn_a, p.rn_b, &vn);
+    Along(v, normal, rn_a, rn_b, &vn);
     const LaneMask closing =
         (c->point_count > i) & ~p.closed & (separation[i] + h * vn <= LaneDoubles{});
     p.closed |= closing;
@@ -200,41 +240,96 @@ template <bool kMotion>
   return AnyLane(fast);
 }
 
+// The solve pass's drift correction of the tangent rows: the slip of the
+// friction anchors along t_k since the step began, s_k = s0_k + t_k.dx +
+// (anchor_a x t_k).dtheta_a - (anchor_b x t_k).dtheta_b, adds b s_k to
+// their velocities.
+template <typename Block>
+[[gnu::always_inline]] inline void AddSlipBias(const Block& c, const LaneBodies& v,
+                                               const LaneDoubles (&tangent)[2][3],
+                                               LaneDoubles (&velocity)[2]) {
+  LaneDoubles dx[3], anchor_a[3], anchor_b[3], bias_rate;
+  for (int axis = 0; axis < 3; ++axis) dx[axis] = v.dx_a[axis] - v.dx_b[axis];
+  Widen(c.anchor_a, anchor_a);
+  Widen(c.anchor_b, anchor_b);
+  Widen(c.bias_rate, &bias_rate);
+  for (int k = 0; k < 2; ++k) {
+    LaneDoubles anchor_t_a[3], anchor_t_b[3];
+    Cross(anchor_a, tangent[k], anchor_t_a);
+    Cross(anchor_b, tangent[k], anchor_t_b);
+    LaneDoubles along, turn_a, turn_b, slip_start;
+    Dot(tangent[k], dx, &along);
+    Dot(anchor_t_a, v.dtheta_a, &turn_a);
+    Dot(anchor_t_b, v.dtheta_b, &turn_b);
+    Widen(c.slip_start[k], &slip_start);
+    const LaneDoubles slip = slip_start + along + turn_a - turn_b;
+    velocity[k] += bias_rate * slip;
+  }
+}
+
+// The twist row about the normal, bounded by mu times the normal impulse
+// times the twist arm (SoftContactSolver::SolveFriction's last row).
+template <typename Block>
+[[gnu::always_inline]] inline void SolveTwistLanes(const LaneDoubles& limit, Block* c,
+                                                   LaneBodies* v) {
+  LaneDoubles twist_arm;
+  Widen(c->twist_arm, &twist_arm);
+  const LaneDoubles twist_limit = limit * twist_arm;
+  LaneDoubles spin_rate[3], normal_axis[3], twist_a[3], twist_b[3];
+  for (int axis = 0; axis < 3; ++axis) spin_rate[axis] = v->w_a[axis] - v->w_b[axis];
+  Widen(c->normal, normal_axis);
+  Widen(c->twist_a, twist_a);
+  Widen(c->twist_b, twist_b);
+  LaneDoubles spin;
+  Dot(normal_axis, spin_rate, &spin);
+  // std::clamp(x, lo, hi): lo where x < lo, else hi where hi < x, else x.
+  const LaneDoubles x = c->twist_impulse - c->twist_mass * spin;
+  const LaneDoubles low = -twist_limit;
+  const LaneDoubles twist = x < low ? low : (twist_limit < x ? twist_limit : x);
+  const LaneDoubles turn = twist - c->twist_impulse;
+  // The scalar update applies its twist as an impulse of zero with inverse
+  // masses of zero, adding 0 * 0 to each linear velocity; so do the lanes,
+  // which keeps the sign of a velocity component of zero as it does.
+  const LaneDoubles zero = {};
+  for (int axis = 0; axis < 3; ++axis) {
+    v->v_a[axis] = v->v_a[axis] + zero * zero;
+    v->w_a[axis] = v->w_a[axis] + turn * twist_a[axis];
+    v->v_b[axis] = v->v_b[axis] - zero * zero;
+    v->w_b[axis] = v->w_b[axis] - turn * twist_b[axis];
+  }
+  c->twist_impulse = twist;
+}
+
 // Coulomb's cone at the centroid and the twist, as
 // SoftContactSolver::SolveFriction.
-[[gnu::always_inline]] inline void SolveFrictionLanes(bool use_bias, SoftLaneBlock* c,
-                                                      LaneBodies* v) {
+template <typename Block>
+[[gnu::always_inline]] inline void SolveFrictionLanes(bool use_bias, Block* c, LaneBodies* v) {
   LaneDoubles normal = {};
   for (int i = 0; i < c->max_points; ++i) {
-    const SoftLanePoint& p = c->points[i];
+    const auto& p = c->points[i];
     normal = c->point_count > i ? normal + p.normal_impulse : normal;
   }
-  const LaneDoubles limit = c->friction * normal;
+  LaneDoubles friction;
+  Widen(c->friction, &friction);
+  const LaneDoubles limit = friction * normal;
+  LaneDoubles tangent[2][3], centre_a[3], centre_b[3];
+  Widen(c->tangent[0], tangent[0]);
+  Widen(c->tangent[1], tangent[1]);
+  Widen(c->centre_a, centre_a);
+  Widen(c->centre_b, centre_b);
   LaneDoubles velocity[2];
   for (int k = 0; k < 2; ++k) {
     LaneDoubles ct_a[3], ct_b[3];
-    Cross(c->centre_a, c->tangent[k], ct_a);
-    Cross(c->centre_b, c->tangent[k], ct_b);
-    Along(*v, c->tangent[k], ct_a, ct_b, &velocity[k]);
+    Cross(centre_a, tangent[k], ct_a);
+    Cross(centre_b, tangent[k], ct_b);
+    Along(*v, tangent[k], ct_a, ct_b, &velocity[k]);
   }
   LaneDoubles mass_scale = LaneDoubles{} + 1.0;
   LaneDoubles impulse_scale = {};
   if (use_bias) {
-    LaneDoubles dx[3];
-    for (int axis = 0; axis < 3; ++axis) dx[axis] = v->dx_a[axis] - v->dx_b[axis];
-    for (int k = 0; k < 2; ++k) {
-      LaneDoubles anchor_t_a[3], anchor_t_b[3];
-      Cross(c->anchor_a, c->tangent[k], anchor_t_a);
-      Cross(c->anchor_b, c->tangent[k], anchor_t_b);
-      LaneDoubles along, turn_a, turn_b;
-      Dot(c->tangent[k], dx, &along);
-      Dot(anchor_t_a, v->dtheta_a, &turn_a);
-      Dot(anchor_t_b, v->dtheta_b, &turn_b);
-      const LaneDoubles slip = c->slip_start[k] + along + turn_a - turn_b;
-      velocity[k] += c->bias_rate * slip;
-    }
-    mass_scale = c->mass_scale;
-    impulse_scale = c->impulse_scale;
+    AddSlipBias(*c, *v, tangent, velocity);
+    Widen(c->mass_scale, &mass_scale);
+    Widen(c->impulse_scale, &impulse_scale);
   }
   const LaneDoubles(&block)[3] = c->tangent_block;
   const LaneDoubles old[2] = {c->tangent_impulse[0], c->tangent_impulse[1]};
@@ -254,41 +349,27 @@ template <bool kMotion>
   }
   const LaneDoubles d0 = next[0] - old[0];
   const LaneDoubles d1 = next[1] - old[1];
+  LaneDoubles ang_t_a[2][3], ang_t_b[2][3];
+  for (int k = 0; k < 2; ++k) {
+    Widen(c->ang_t_a[k], ang_t_a[k]);
+    Widen(c->ang_t_b[k], ang_t_b[k]);
+  }
   LaneDoubles push[3], turn_a[3], turn_b[3];
   for (int axis = 0; axis < 3; ++axis) {
-    push[axis] = d0 * c->tangent[0][axis] + d1 * c->tangent[1][axis];
-    turn_a[axis] = d0 * c->ang_t_a[0][axis] + d1 * c->ang_t_a[1][axis];
-    turn_b[axis] = d0 * c->ang_t_b[0][axis] + d1 * c->ang_t_b[1][axis];
+    push[axis] = d0 * tangent[0][axis] + d1 * tangent[1][axis];
+    turn_a[axis] = d0 * ang_t_a[0][axis] + d1 * ang_t_a[1][axis];
+    turn_b[axis] = d0 * ang_t_b[0][axis] + d1 * ang_t_b[1][axis];
   }
   const LaneMask all = LaneMask{} == LaneMask{};
   Apply(all, push, *c, turn_a, turn_b, v);
   c->tangent_impulse[0] = next[0];
   c->tangent_impulse[1] = next[1];
-  const LaneDoubles twist_limit = limit * c->twist_arm;
-  LaneDoubles spin_rate[3];
-  for (int axis = 0; axis < 3; ++axis) spin_rate[axis] = v->w_a[axis] - v->w_b[axis];
-  LaneDoubles spin;
-  Dot(c->normal, spin_rate, &spin);
-  // std::clamp(x, lo, hi): lo where x < lo, else hi where hi < x, else x.
-  const LaneDoubles x = c->twist_impulse - c->twist_mass * spin;
-  const LaneDoubles low = -twist_limit;
-  const LaneDoubles twist = x < low ? low : (twist_limit < x ? twist_limit : x);
-  const LaneDoubles turn = twist - c->twist_impulse;
-  // The scalar update applies its twist as an impulse of zero with inverse
-  // masses of zero, adding 0 * 0 to each linear velocity; so do the lanes,
-  // which keeps the sign of a velocity component of zero as it does.
-  const LaneDoubles zero = {};
-  for (int axis = 0; axis < 3; ++axis) {
-    v->v_a[axis] = v->v_a[axis] + zero * zero;
-    v->w_a[axis] = v->w_a[axis] + turn * c->twist_a[axis];
-    v->v_b[axis] = v->v_b[axis] - zero * zero;
-    v->w_b[axis] = v->w_b[axis] - turn * c->twist_b[axis];
-  }
-  c->twist_impulse = twist;
+  SolveTwistLanes(limit, c, v);
 }
 
+template <typename Block>
 [[gnu::always_inline]] inline bool SolveBlock(const SoftLaneContext& context, bool use_bias,
-                                              SoftLaneBlock* c) {
+                                              Block* c) {
   LaneBodies v;
   Gather</*kMotion=*/true>(*c, *context.states, &v);
   LaneDoubles separation[ContactManifold::kMaxPoints];
@@ -297,26 +378,36 @@ template <bool kMotion>
   const LaneDoubles inverse_h = zero + 1.0 / context.h;
   const LaneDoubles max_push = zero - context.max_push_velocity;
   const LaneDoubles one = zero + 1.0;
+  LaneDoubles normal[3], bias_rate, soft_mass_scale, soft_impulse_scale;
+  Widen(c->normal, normal);
+  Widen(c->bias_rate, &bias_rate);
+  Widen(c->mass_scale, &soft_mass_scale);
+  Widen(c->impulse_scale, &soft_impulse_scale);
   for (int i = 0; i < c->max_points; ++i) {
-    SoftLanePoint& p = c->points[i];
+    auto& p = c->points[i];
     const LaneDoubles s = separation[i];
+    LaneDoubles rn_a[3], rn_b[3];
+    Widen(p.rn_a, rn_a);
+    Widen(p.rn_b, rn_b);
     LaneDoubles vn;
-    Along(v, c->normal, p.rn_a, p.rn_b, &vn);
+    Along(v, normal, rn_a, rn_b, &vn);
     const LaneMask apart = s > zero;
     LaneDoubles bias = zero;
     LaneDoubles mass_scale = one;
     LaneDoubles impulse_scale = zero;
     if (use_bias) {
-      const LaneDoubles spring = c->bias_rate * s;
+      const LaneDoubles spring = bias_rate * s;
       bias = spring < max_push ? max_push : spring;
-      mass_scale = c->mass_scale;
-      impulse_scale = c->impulse_scale;
+      mass_scale = soft_mass_scale;
+      impulse_scale = soft_impulse_scale;
     }
     bias = apart ? s * inverse_h : bias;
     mass_scale = apart ? one : mass_scale;
     impulse_scale = apart ? zero : impulse_scale;
+    LaneDoubles preload;
+    Widen(p.preload, &preload);
     const LaneDoubles change =
-        -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * (p.normal_impulse - p.preload);
+        -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * (p.normal_impulse - preload);
     const LaneDoubles sum = p.normal_impulse + change;
     const LaneDoubles next = sum < zero ? zero : sum;
     const LaneDoubles applied = next - p.normal_impulse;
@@ -329,7 +420,7 @@ template <bool kMotion>
   SolveFrictionLanes(use_bias, c, &v);
   if (!use_bias) {
     for (int i = 0; i < c->max_points; ++i) {
-      SoftLanePoint& p = c->points[i];
+      auto& p = c->points[i];
       const LaneDoubles total = p.total_normal_impulse + p.normal_impulse;
       p.total_normal_impulse = c->point_count > i ? total : p.total_normal_impulse;
     }
@@ -342,8 +433,9 @@ template <bool kMotion>
 
 }  // namespace
 
+template <typename Block>
 void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int lanes,
-                   const std::vector<std::uint8_t>& moving, SoftLaneBlock* block) {
+                   const std::vector<std::uint8_t>& moving, Block* block) {
   // Only the lanes and points that hold a row are written: the others keep
   // whatever finite values an earlier step left (a new block starts at
   // zero), which the updates compute with and then discard.
@@ -367,11 +459,11 @@ void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int l
     SetLane(c.normal, lane, block->normal);
     block->inverse_mass_a[lane] = c.inverse_mass_a;
     block->inverse_mass_b[lane] = c.inverse_mass_b;
-    block->friction[lane] = c.friction;
-    block->restitution[lane] = c.restitution;
-    block->bias_rate[lane] = c.bias_rate;
-    block->mass_scale[lane] = c.mass_scale;
-    block->impulse_scale[lane] = c.impulse_scale;
+    SetLane(c.friction, lane, &block->friction);
+    SetLane(c.restitution, lane, &block->restitution);
+    SetLane(c.bias_rate, lane, &block->bias_rate);
+    SetLane(c.mass_scale, lane, &block->mass_scale);
+    SetLane(c.impulse_scale, lane, &block->impulse_scale);
     SetLane(c.anchor_a, lane, block->anchor_a);
     SetLane(c.anchor_b, lane, block->anchor_b);
     PackFriction(c, lane, block);
@@ -381,10 +473,10 @@ void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int l
   }
 }
 
-void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
-                           SoftConstraint* constraint) {
+template <typename Block>
+void ExtractSoftConstraint(const Block& block, int lane, bool rows, SoftConstraint* constraint) {
   SoftConstraint& c = *constraint;
-  auto get = [lane](const LaneDoubles(&lanes)[3]) {
+  auto get = [lane](const auto& lanes) {
     return Vec3(lanes[0][lane], lanes[1][lane], lanes[2][lane]);
   };
   c.body_a = block.body_a[lane];
@@ -406,7 +498,7 @@ void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
   }
   c.twist_impulse = block.twist_impulse[lane];
   for (int i = 0; i < c.point_count; ++i) {
-    const SoftLanePoint& from = block.points[i];
+    const auto& from = block.points[i];
     SoftPoint& p = c.points[i];
     if (rows) {
       p.rn_a = get(from.rn_a);
@@ -427,18 +519,53 @@ void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
   }
 }
 
+namespace {
+
+template <typename Block>
+[[gnu::always_inline]] inline void WarmStartBlocks(const SoftLaneContext& context, Block* begin,
+                                                   Block* end) {
+  for (Block* block = begin; block != end; ++block) WarmStartBlock(context, *block);
+}
+
+template <typename Block>
+[[gnu::always_inline]] inline bool SolveBlocks(const SoftLaneContext& context, bool use_bias,
+                                               Block* begin, Block* end) {
+  bool fast = false;
+  for (Block* block = begin; block != end; ++block) {
+    fast |= use_bias ? SolveBlock(context, true, block) : SolveBlock(context, false, block);
+  }
+  return fast;
+}
+
+}  // namespace
+
+template void PackSoftBlock(const SoftConstraint*, std::uint32_t, int,
+                            const std::vector<std::uint8_t>&, SoftLaneBlock*);
+template void PackSoftBlock(const SoftConstraint*, std::uint32_t, int,
+                            const std::vector<std::uint8_t>&, CompactSoftLaneBlock*);
+template void ExtractSoftConstraint(const SoftLaneBlock&, int, bool, SoftConstraint*);
+template void ExtractSoftConstraint(const CompactSoftLaneBlock&, int, bool, SoftConstraint*);
+
+// The entry points are plain functions, one per block layout, as GCC
+// clones plain functions for the two targets (RBS_SIMD_CLONES).
 RBS_SIMD_CLONES void WarmStartSoftBlocks(const SoftLaneContext& context, SoftLaneBlock* begin,
                                          SoftLaneBlock* end) {
-  for (SoftLaneBlock* block = begin; block != end; ++block) WarmStartBlock(context, *block);
+  WarmStartBlocks(context, begin, end);
+}
+
+RBS_SIMD_CLONES void WarmStartSoftBlocks(const SoftLaneContext& context,
+                                         CompactSoftLaneBlock* begin, CompactSoftLaneBlock* end) {
+  WarmStartBlocks(context, begin, end);
 }
 
 RBS_SIMD_CLONES bool SolveSoftBlocks(const SoftLaneContext& context, bool use_bias,
                                      SoftLaneBlock* begin, SoftLaneBlock* end) {
-  bool fast = false;
-  for (SoftLaneBlock* block = begin; block != end; ++block) {
-    fast |= use_bias ? SolveBlock(context, true, block) : SolveBlock(context, false, block);
-  }
-  return fast;
+  return SolveBlocks(context, use_bias, begin, end);
+}
+
+RBS_SIMD_CLONES bool SolveSoftBlocks(const SoftLaneContext& context, bool use_bias,
+                                     CompactSoftLaneBlock* begin, CompactSoftLaneBlock* end) {
+  return SolveBlocks(context, use_bias, begin, end);
 }
 
 }  // namespace rigid_body_sim::physics

@@ -23,15 +23,20 @@
 namespace rigid_body_sim::physics {
 
 // A point row of each lane's constraint; [axis] is x, y, z in the world.
-struct SoftLanePoint {
-  LaneDoubles rn_a[3];  // r_a x n
-  LaneDoubles rn_b[3];
-  LaneDoubles ang_a[3];  // I_a^-1 (r_a x n)
-  LaneDoubles ang_b[3];
-  LaneDoubles start_separation;  // m
-  LaneDoubles normal_mass;       // kg
-  LaneDoubles normal_impulse;    // N s
-  LaneDoubles preload;           // N s
+// What the sub-steps only read is `Stored`: LaneDoubles in a wide block,
+// LaneFloats in a compact one (kCompact). The scalar rows hold the same values rounded
+// to floats (NarrowToFloat), so both layouts give the scalar update's bits.
+template <bool kCompact>
+struct SoftLanePointOf {
+  using Stored = typename LaneStored<kCompact>::Type;
+  Stored rn_a[3];  // r_a x n
+  Stored rn_b[3];
+  Stored ang_a[3];  // I_a^-1 (r_a x n)
+  Stored ang_b[3];
+  Stored start_separation;     // m
+  Stored preload;              // N s
+  LaneDoubles normal_mass;     // kg
+  LaneDoubles normal_impulse;  // N s
   LaneDoubles max_normal_impulse;
   LaneDoubles total_normal_impulse;
   LaneDoubles approach_velocity;  // m/s
@@ -39,8 +44,14 @@ struct SoftLanePoint {
 };
 
 // Up to four constraints of one colour in structure-of-arrays form: the
-// SoftConstraint fields the sub-steps read and write.
-struct SoftLaneBlock {
+// SoftConstraint fields the sub-steps read and write. The sub-steps stream
+// every block once a pass, and the big scenes' blocks outgrow the cache: so
+// the lanes form c x t_k and anchor x t_k from the centroids and anchors as
+// they go (Cross), and a compact block (SoftStepSettings::
+// compact_blocks_from) keeps what is only read in floats.
+template <bool kCompact>
+struct SoftLaneBlockOf {
+  using Stored = typename LaneStored<kCompact>::Type;
   std::array<std::uint32_t, kBatchLanes> constraint;  // index in the solver's constraints
   std::array<std::uint32_t, kBatchLanes> body_a;
   std::array<std::uint32_t, kBatchLanes> body_b;
@@ -48,39 +59,38 @@ struct SoftLaneBlock {
   std::array<bool, kBatchLanes> moves_b;
   int lanes;       // lanes holding a constraint, the first ones
   int max_points;  // the most points of any lane's manifold
-  LaneDoubles normal[3];
-  LaneDoubles tangent[2][3];
+  Stored normal[3];
+  Stored tangent[2][3];
+  Stored friction;
+  Stored bias_rate;  // 1/s
+  Stored mass_scale;
+  Stored impulse_scale;
+  Stored centre_a[3];  // m, c_a
+  Stored centre_b[3];
+  Stored anchor_a[3];  // m
+  Stored anchor_b[3];
+  Stored ang_t_a[2][3];  // I_a^-1 (c_a x t_k)
+  Stored ang_t_b[2][3];
+  Stored twist_a[3];  // I_a^-1 n
+  Stored twist_b[3];
+  Stored twist_arm;  // m
+  Stored slip_start[2];
+  Stored restitution;  // read only after the sub-steps
   LaneDoubles inverse_mass_a;
   LaneDoubles inverse_mass_b;
-  LaneDoubles friction;
-  LaneDoubles bias_rate;
-  LaneDoubles mass_scale;
-  LaneDoubles impulse_scale;
-  // The centroid c of each body's points and the friction anchors, from
-  // which the lanes form c x t_k and anchor x t_k as they go (Cross): a
-  // smaller block, as the sub-steps stream every block a pass and the big
-  // scenes' blocks outgrow the cache.
-  LaneDoubles centre_a[3];
-  LaneDoubles centre_b[3];
-  LaneDoubles anchor_a[3];
-  LaneDoubles anchor_b[3];
-  LaneDoubles ang_t_a[2][3];
-  LaneDoubles ang_t_b[2][3];
-  LaneDoubles twist_a[3];
-  LaneDoubles twist_b[3];
   LaneDoubles tangent_block[3];
   LaneDoubles twist_mass;
-  LaneDoubles twist_arm;
-  LaneDoubles slip_start[2];
   LaneDoubles tangent_impulse[2];
   LaneDoubles twist_impulse;
   LaneDoubles total_tangent_impulse[2];
   LaneMask point_count;  // a lane's point i is present where i < point_count
-  std::array<SoftLanePoint, ContactManifold::kMaxPoints> points;
+  std::array<SoftLanePointOf<kCompact>, ContactManifold::kMaxPoints> points;
   // Read only after the sub-steps, by the restitution pass and the store.
-  LaneDoubles restitution;
   LaneMask carried[ContactManifold::kMaxPoints];
 };
+
+using SoftLaneBlock = SoftLaneBlockOf<false>;        // 4,640 bytes
+using CompactSoftLaneBlock = SoftLaneBlockOf<true>;  // 3,008 bytes
 
 // What the lane updates read besides the blocks.
 struct SoftLaneContext {
@@ -92,23 +102,29 @@ struct SoftLaneContext {
 
 // Packs constraints[0, lanes), the solver's constraints first to first +
 // lanes - 1, into *block; the other lanes hold no constraint. moving[b] is
-// nonzero for a body the solve writes.
+// nonzero for a body the solve writes. Block is SoftLaneBlock or
+// CompactSoftLaneBlock, as for each function below.
+template <typename Block>
 void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int lanes,
-                   const std::vector<std::uint8_t>& moving, SoftLaneBlock* block);
+                   const std::vector<std::uint8_t>& moving, Block* block);
 // Lane `lane`'s constraint as the sub-steps left it, with the fields that
 // the store reads (SoftContactSolver::Store) and, with `rows`, the normal
 // rows' that the restitution pass reads (Restitute); the friction rows'
 // Jacobians are left unset.
-void ExtractSoftConstraint(const SoftLaneBlock& block, int lane, bool rows,
-                           SoftConstraint* constraint);
+template <typename Block>
+void ExtractSoftConstraint(const Block& block, int lane, bool rows, SoftConstraint* constraint);
 
 // SoftContactSolver::WarmStart on each constraint of blocks [begin, end).
 void WarmStartSoftBlocks(const SoftLaneContext& context, SoftLaneBlock* begin, SoftLaneBlock* end);
+void WarmStartSoftBlocks(const SoftLaneContext& context, CompactSoftLaneBlock* begin,
+                         CompactSoftLaneBlock* end);
 // SoftContactSolver::Solve (use_bias: the solve pass, else the relax pass)
 // on each constraint of blocks [begin, end). Returns whether a point closed
 // faster than the collision threshold.
 bool SolveSoftBlocks(const SoftLaneContext& context, bool use_bias, SoftLaneBlock* begin,
                      SoftLaneBlock* end);
+bool SolveSoftBlocks(const SoftLaneContext& context, bool use_bias, CompactSoftLaneBlock* begin,
+                     CompactSoftLaneBlock* end);
 
 }  // namespace rigid_body_sim::physics
 

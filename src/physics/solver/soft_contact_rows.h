@@ -4,13 +4,29 @@
 #ifndef RIGID_BODY_SIM_PHYSICS_SOLVER_SOFT_CONTACT_ROWS_H_
 #define RIGID_BODY_SIM_PHYSICS_SOLVER_SOFT_CONTACT_ROWS_H_
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "physics/contact/contact_manifold.h"
 #include "rigid_body_sim/physics/types.h"
 
 namespace rigid_body_sim::physics {
+
+// x rounded to the nearest float, held in a double: what the soft step's
+// rows only read is stored in floats in the lanes' blocks
+// (soft_contact_lanes.h), so the scalar rows round it the same way and both
+// compute in double from the same values. Beyond a float's range it
+// saturates, where no finite body's row reaches.
+inline double NarrowToFloat(double x) {
+  constexpr double kLargest = std::numeric_limits<float>::max();
+  return static_cast<float>(std::clamp(x, -kLargest, kLargest));
+}
+
+inline Vec3 NarrowToFloat(const Vec3& v) {
+  return Vec3(NarrowToFloat(v.x()), NarrowToFloat(v.y()), NarrowToFloat(v.z()));
+}
 
 // What the rows read and write of a body in the sub-steps, packed: the
 // velocities, and the motion since the step began, dx and the rotation

@@ -34,6 +34,12 @@ std::pair<std::size_t, std::size_t> Share(std::size_t count, int thread, int thr
   return {begin, end};
 }
 
+// x as the rows keep what the sub-steps only read: rounded to a float in a
+// step with compact blocks (SoftStepSettings::compact_blocks_from), so
+// that the scalar update and the lanes compute with what those blocks hold.
+double Kept(bool compact, double x) { return compact ? NarrowToFloat(x) : x; }
+Vec3 Kept(bool compact, const Vec3& x) { return compact ? NarrowToFloat(x) : x; }
+
 // 1 / k for k > 0, else 0 (a row neither body can move).
 double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
@@ -55,7 +61,9 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
       const int lanes =
           static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
       for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
-      PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks_[first_block + b]);
+      WithBlocks([&](auto& blocks) {
+        PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks[first_block + b]);
+      });
     }
   }
   const auto [begin, end] = Share(colouring_.overflow_count(), thread, threads);
@@ -77,6 +85,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   touch_tolerance_ = input.touch_tolerance;
   load_tracking_ = input.settings.load_tracking;
   lanes_ = input.settings.simd_lanes;
+  compact_blocks_from_ = input.settings.compact_blocks_from;
   may_bounce_.store(false, std::memory_order_relaxed);
   moving_.clear();
   moving_mask_.assign(bodies->size(), 0);
@@ -118,7 +127,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], constraint);
   };
   auto run = [&](int thread) {
-    if (blocks_.empty()) {
+    if (block_count_ == 0) {
       const auto [begin, end] = Share(constraints_.size(), thread, threads);
       for (std::size_t k = begin; k < end; ++k) prepare(k, &constraints_[k]);
     } else {
@@ -128,7 +137,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     RunSubsteps(thread, threads, &barrier);
     // The constraints not in a block: all of them without lanes, else the
     // overflow set.
-    const std::size_t first_scalar = blocks_.empty() ? 0 : colouring_.colour_start.back();
+    const std::size_t first_scalar = block_count_ == 0 ? 0 : colouring_.colour_start.back();
     const auto [begin, end] = Share(constraints_.size() - first_scalar, thread, threads);
     for (std::size_t k = first_scalar + begin; k < first_scalar + end; ++k) {
       Store(k, constraints_[k]);
@@ -160,12 +169,15 @@ void SoftContactSolver::Prepare(const SoftStepInput& input, const std::vector<So
   const SoftBody& b = bodies[manifold.body_b];
   c.body_a = manifold.body_a;
   c.body_b = manifold.body_b;
-  c.normal = manifold.normal_world;
+  // What the sub-steps only read is rounded to floats in a compact step
+  // (Kept); the masses and impulses stay doubles.
+  c.normal = Kept(compact_, manifold.normal_world);
   c.tangent = TangentBasis(c.normal);
+  for (Vec3& t : c.tangent) t = Kept(compact_, t);
   c.inverse_mass_a = a.inverse_mass;
   c.inverse_mass_b = b.inverse_mass;
-  c.friction = manifold.friction;
-  c.restitution = manifold.restitution;
+  c.friction = Kept(compact_, manifold.friction);
+  c.restitution = Kept(compact_, manifold.restitution);
   // A spring stiffer than a quarter of the sub-step rate is not followed by
   // one iteration a sub-step (Box2D v3 caps it the same way); a contact
   // with a body that does not move takes twice the frequency.
@@ -173,23 +185,23 @@ void SoftContactSolver::Prepare(const SoftStepInput& input, const std::vector<So
   const double hertz = input.settings.contact_hertz * (a.moving && b.moving ? 1.0 : 2.0);
   const Softness soft =
       MakeSoftness(std::min(hertz, max_hertz), input.settings.contact_damping_ratio, h_);
-  c.bias_rate = soft.bias_rate;
-  c.mass_scale = soft.mass_scale;
-  c.impulse_scale = soft.impulse_scale;
+  c.bias_rate = Kept(compact_, soft.bias_rate);
+  c.mass_scale = Kept(compact_, soft.mass_scale);
+  c.impulse_scale = Kept(compact_, soft.impulse_scale);
   c.point_count = manifold.point_count;
   const double share = 1.0 / substeps_;
   for (int i = 0; i < c.point_count; ++i) {
     const SolverPoint& from = manifold.points[i];
     Point& p = c.points[i];
-    p.rn_a = from.r_a.cross(c.normal);
-    p.rn_b = from.r_b.cross(c.normal);
-    p.ang_a = a.inverse_inertia_world * p.rn_a;
-    p.ang_b = b.inverse_inertia_world * p.rn_b;
-    p.start_separation = from.separation;
+    p.rn_a = Kept(compact_, from.r_a.cross(c.normal));
+    p.rn_b = Kept(compact_, from.r_b.cross(c.normal));
+    p.ang_a = Kept(compact_, a.inverse_inertia_world * p.rn_a);
+    p.ang_b = Kept(compact_, b.inverse_inertia_world * p.rn_b);
+    p.start_separation = Kept(compact_, from.separation);
     p.normal_mass =
         InverseOrZero(a.inverse_mass + b.inverse_mass + p.rn_a.dot(p.ang_a) + p.rn_b.dot(p.ang_b));
     p.normal_impulse = share * std::max(from.normal_impulse, 0.0);
-    p.preload = share * std::max(from.preload, 0.0);
+    p.preload = Kept(compact_, share * std::max(from.preload, 0.0));
     p.max_normal_impulse = 0.0;
     p.total_normal_impulse = 0.0;
     // A point that closed at the end of the last step, before it touched,
@@ -234,18 +246,21 @@ void SoftContactSolver::PrepareFriction(const SoftBody& a, const SoftBody& b,
     const Vec3 offset = manifold.points[i].r_a - centre_a;
     c->twist_arm += inverse_count * (offset - offset.dot(c->normal) * c->normal).norm();
   }
+  c->twist_arm = Kept(compact_, c->twist_arm);
+  centre_a = Kept(compact_, centre_a);
+  centre_b = Kept(compact_, centre_b);
   c->centre_a = centre_a;
   c->centre_b = centre_b;
-  c->anchor_a = anchor.valid ? a.orientation * anchor.on_a : centre_a;
-  c->anchor_b = anchor.valid ? b.orientation * anchor.on_b : centre_b;
+  c->anchor_a = anchor.valid ? Kept(compact_, a.orientation * anchor.on_a) : centre_a;
+  c->anchor_b = anchor.valid ? Kept(compact_, b.orientation * anchor.on_b) : centre_b;
   const Vec3 anchors_apart = a.position + c->anchor_a - b.position - c->anchor_b;
   for (int k = 0; k < 2; ++k) {
     const Vec3& t = c->tangent[k];
     c->ct_a[k] = centre_a.cross(t);
     c->ct_b[k] = centre_b.cross(t);
-    c->ang_t_a[k] = a.inverse_inertia_world * c->ct_a[k];
-    c->ang_t_b[k] = b.inverse_inertia_world * c->ct_b[k];
-    c->slip_start[k] = t.dot(anchors_apart);
+    c->ang_t_a[k] = Kept(compact_, a.inverse_inertia_world * c->ct_a[k]);
+    c->ang_t_b[k] = Kept(compact_, b.inverse_inertia_world * c->ct_b[k]);
+    c->slip_start[k] = Kept(compact_, t.dot(anchors_apart));
     c->anchor_t_a[k] = c->anchor_a.cross(t);
     c->anchor_t_b[k] = c->anchor_b.cross(t);
   }
@@ -260,8 +275,8 @@ void SoftContactSolver::PrepareFriction(const SoftBody& a, const SoftBody& b,
   const double det = kxx * kyy - kxy * kxy;
   c->tangent_block = det > 0.0 ? std::array<double, 3>{kyy / det, -kxy / det, kxx / det}
                                : std::array<double, 3>{0.0, 0.0, 0.0};
-  c->twist_a = a.inverse_inertia_world * c->normal;
-  c->twist_b = b.inverse_inertia_world * c->normal;
+  c->twist_a = Kept(compact_, a.inverse_inertia_world * c->normal);
+  c->twist_b = Kept(compact_, b.inverse_inertia_world * c->normal);
   c->twist_mass = InverseOrZero(c->normal.dot(c->twist_a + c->twist_b));
   c->twist_impulse = 0.0;
   c->total_tangent_impulse = {0.0, 0.0};
@@ -280,7 +295,7 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
   // Every thread reads the flag after the last relax pass's barrier, so all
   // take the same branch.
   const bool bounce = may_bounce_.load(std::memory_order_relaxed);
-  if (blocks_.empty()) {
+  if (block_count_ == 0) {
     if (bounce) RunPass(Pass::kRestitution, thread, threads, barrier);
     return;
   }
@@ -296,14 +311,15 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
     const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
-    for (std::size_t b = first_block + begin; b < first_block + end; ++b) {
-      const SoftLaneBlock& block = blocks_[b];
-      for (int lane = 0; lane < block.lanes; ++lane) {
-        ExtractSoftConstraint(block, lane, /*rows=*/bounce, &c);
-        if (bounce) Restitute(&c);
-        Store(block.constraint[lane], c);
+    WithBlocks([&](const auto& blocks) {
+      for (std::size_t b = first_block + begin; b < first_block + end; ++b) {
+        for (int lane = 0; lane < blocks[b].lanes; ++lane) {
+          ExtractSoftConstraint(blocks[b], lane, /*rows=*/bounce, &c);
+          if (bounce) Restitute(&c);
+          Store(blocks[b].constraint[lane], c);
+        }
       }
-    }
+    });
     if (bounce) barrier->Wait();
   }
   if (!bounce || colouring_.overflow_count() == 0) return;
@@ -318,7 +334,7 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
 void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier) {
   const std::vector<std::uint32_t>& start = colouring_.colour_start;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
-    if (!blocks_.empty() && pass != Pass::kRestitution) {
+    if (block_count_ > 0 && pass != Pass::kRestitution) {
       ApplyToBlocks(pass, colour, thread, threads);
     } else {
       const std::size_t size = start[colour + 1] - start[colour];
@@ -339,13 +355,12 @@ void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier*
 }
 
 // Four consecutive constraints of a colour to a block, the colour's last
-// block holding what is left; none without simd_lanes.
+// block holding what is left; none without simd_lanes. From
+// compact_blocks_from blocks on, the blocks are compact: the passes stream
+// every block, and past the cache a block's bytes cost more than its
+// floats' conversions (docs/performance.md).
 void SoftContactSolver::ListBlocks() {
   block_start_.assign(1, 0);
-  if (!lanes_) {
-    blocks_.clear();
-    return;
-  }
   const std::vector<std::uint32_t>& start = colouring_.colour_start;
   std::size_t count = 0;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
@@ -353,8 +368,15 @@ void SoftContactSolver::ListBlocks() {
     count += (size + kBatchLanes - 1) / kBatchLanes;
     block_start_.push_back(static_cast<std::uint32_t>(count));
   }
+  // Without lanes the step is compact as it would be with them: the scalar
+  // update rounds the same rows.
+  compact_ = count >= static_cast<std::size_t>(compact_blocks_from_);
+  block_count_ = lanes_ ? count : 0;
+  if (!lanes_) return;
   // Kept from step to step: PackSoftBlock writes what a block's rows use.
-  blocks_.resize(count);
+  WithBlocks([count](auto& blocks) {
+    if (blocks.size() < count) blocks.resize(count);
+  });
 }
 
 void SoftContactSolver::ApplyToBlocks(Pass pass, int colour, int thread, int threads) {
@@ -365,13 +387,15 @@ void SoftContactSolver::ApplyToBlocks(Pass pass, int colour, int thread, int thr
   context.collision_velocity_threshold = collision_velocity_threshold_;
   const std::size_t first_block = block_start_[colour];
   const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
-  SoftLaneBlock* const from = blocks_.data() + first_block + begin;
-  SoftLaneBlock* const to = blocks_.data() + first_block + end;
-  if (pass == Pass::kWarmStart) {
-    WarmStartSoftBlocks(context, from, to);
-  } else if (SolveSoftBlocks(context, pass == Pass::kSolve, from, to)) {
-    may_bounce_.store(true, std::memory_order_relaxed);
-  }
+  WithBlocks([&](auto& blocks) {
+    auto* const from = blocks.data() + first_block + begin;
+    auto* const to = blocks.data() + first_block + end;
+    if (pass == Pass::kWarmStart) {
+      WarmStartSoftBlocks(context, from, to);
+    } else if (SolveSoftBlocks(context, pass == Pass::kSolve, from, to)) {
+      may_bounce_.store(true, std::memory_order_relaxed);
+    }
+  });
 }
 
 void SoftContactSolver::Apply(Pass pass, Constraint* constraint) {

@@ -119,6 +119,15 @@ class SoftContactSolver {
   // The lane updates of `pass` on this thread's share of colour `colour`'s
   // blocks.
   void ApplyToBlocks(Pass pass, int colour, int thread, int threads);
+  // f(blocks) with this step's layout's vector of blocks.
+  template <typename F>
+  void WithBlocks(const F& f) {
+    if (compact_) {
+      f(compact_blocks_);
+    } else {
+      f(blocks_);
+    }
+  }
   void StoreAnchor(const Constraint& constraint, FrictionAnchor* anchor) const;
   // Constraint k's results into its manifold (colouring_.order[k]) and its
   // friction anchor.
@@ -138,8 +147,15 @@ class SoftContactSolver {
   std::vector<std::uint8_t> moving_mask_;  // per body
   std::vector<std::uint32_t> colour_masks_;
   std::vector<std::uint8_t> colour_of_;
-  bool lanes_ = true;  // SoftStepSettings::simd_lanes
+  bool lanes_ = true;            // SoftStepSettings::simd_lanes
+  int compact_blocks_from_ = 0;  // SoftStepSettings::compact_blocks_from
+  // The blocks, this step's first block_count_ of blocks_ or (compact_) of
+  // compact_blocks_; each vector only grows, so a layout met again is
+  // not allocated again.
+  std::size_t block_count_ = 0;
+  bool compact_ = false;
   std::vector<SoftLaneBlock> blocks_;
+  std::vector<CompactSoftLaneBlock> compact_blocks_;
   std::vector<std::uint32_t> block_start_;  // colour c's blocks: [block_start_[c], [c + 1])
   double h_ = 0.0;                          // s, the sub-step
   int substeps_ = 1;

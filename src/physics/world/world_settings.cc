@@ -63,6 +63,7 @@ Status ValidateSoftStepSettings(const SoftStepSettings& settings) {
           ? Status::Ok()
           : Status::Error("load_tracking " + FormatNumber(settings.load_tracking) +
                           " must be in [0, 1]"),
+      AtLeast("compact_blocks_from", settings.compact_blocks_from, 0),
   });
 }
 
