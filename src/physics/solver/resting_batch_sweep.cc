@@ -26,14 +26,6 @@ struct BatchVelocities {
   LaneDoubles angular_b[3];
 };
 
-// out = a x b, as Eigen's cross product of 3-vectors computes it.
-[[gnu::always_inline]] inline void Cross(const LaneDoubles (&a)[3], const LaneDoubles (&b)[3],
-                                         LaneDoubles (&out)[3]) {
-  out[0] = a[1] * b[2] - a[2] * b[1];
-  out[1] = a[2] * b[0] - a[0] * b[2];
-  out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 // *target = value in the lanes of `active`; with kAllActive every lane is,
 // and no lane needs selecting.
 template <bool kAllActive>

@@ -60,6 +60,15 @@ struct LaneStored<true> {
   *out = (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
 }
 
+// out = a x b, with the operations of Eigen's cross product of 3-vectors in
+// its order, so a lane gives the bits of the scalar rows' products.
+[[gnu::always_inline]] inline void Cross(const LaneDoubles (&a)[3], const LaneDoubles (&b)[3],
+                                         LaneDoubles (&out)[3]) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 // Whether any lane of `mask` is set.
 [[gnu::always_inline]] inline bool AnyLane(const LaneMask& mask) {
   bool any = false;

@@ -128,15 +128,6 @@ template <typename Block>
   *out = along + turn_a - turn_b;
 }
 
-// a x b, with Eigen's cross's operations in its order (so a lane gives
-// the bits that the scalar rows' precomputed products hold).
-[[gnu::always_inline]] inline void Cross(const LaneDoubles (&a)[3], const LaneDoubles (&b)[3],
-                                         LaneDoubles (&out)[3]) {
-  out[0] = a[1] * b[2] - a[2] * b[1];
-  out[1] = a[2] * b[0] - a[0] * b[2];
-  out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 // PairVelocities::Apply in the lanes of `on`: impulse p on A, -p on B,
 // their turns given.
 template <typename Block>
