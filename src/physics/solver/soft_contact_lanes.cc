@@ -14,8 +14,9 @@ static_assert(alignof(decltype(CompactSoftLaneBlock::normal[0])) == sizeof(LaneF
 
 namespace {
 
-// Lane `lane` of the 3-vectors lanes[axis] set from v, which holds floats'
-// values (NarrowToFloat), so exactly.
+// Lane `lane` of the lanes set from x (of the 3-vectors lanes[axis] from
+// v). Into floats only in a compact step, whose rows hold floats' values
+// (NarrowToFloat), so exactly.
 void SetLane(double x, int lane, LaneFloats* lanes) { (*lanes)[lane] = static_cast<float>(x); }
 void SetLane(double x, int lane, LaneDoubles* lanes) { (*lanes)[lane] = x; }
 

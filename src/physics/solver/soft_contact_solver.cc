@@ -127,7 +127,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], constraint);
   };
   auto run = [&](int thread) {
-    if (block_count_ == 0) {
+    if (!HasBlocks()) {
       const auto [begin, end] = Share(constraints_.size(), thread, threads);
       for (std::size_t k = begin; k < end; ++k) prepare(k, &constraints_[k]);
     } else {
@@ -137,7 +137,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     RunSubsteps(thread, threads, &barrier);
     // The constraints not in a block: all of them without lanes, else the
     // overflow set.
-    const std::size_t first_scalar = block_count_ == 0 ? 0 : colouring_.colour_start.back();
+    const std::size_t first_scalar = HasBlocks() ? colouring_.colour_start.back() : 0;
     const auto [begin, end] = Share(constraints_.size() - first_scalar, thread, threads);
     for (std::size_t k = first_scalar + begin; k < first_scalar + end; ++k) {
       Store(k, constraints_[k]);
@@ -295,7 +295,7 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
   // Every thread reads the flag after the last relax pass's barrier, so all
   // take the same branch.
   const bool bounce = may_bounce_.load(std::memory_order_relaxed);
-  if (block_count_ == 0) {
+  if (!HasBlocks()) {
     if (bounce) RunPass(Pass::kRestitution, thread, threads, barrier);
     return;
   }
@@ -334,7 +334,7 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
 void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier) {
   const std::vector<std::uint32_t>& start = colouring_.colour_start;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
-    if (block_count_ > 0 && pass != Pass::kRestitution) {
+    if (HasBlocks() && pass != Pass::kRestitution) {
       ApplyToBlocks(pass, colour, thread, threads);
     } else {
       const std::size_t size = start[colour + 1] - start[colour];
@@ -371,7 +371,6 @@ void SoftContactSolver::ListBlocks() {
   // Without lanes the step is compact as it would be with them: the scalar
   // update rounds the same rows.
   compact_ = count >= static_cast<std::size_t>(compact_blocks_from_);
-  block_count_ = lanes_ ? count : 0;
   if (!lanes_) return;
   // Kept from step to step: PackSoftBlock writes what a block's rows use.
   WithBlocks([count](auto& blocks) {

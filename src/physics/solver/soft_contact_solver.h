@@ -119,6 +119,8 @@ class SoftContactSolver {
   // The lane updates of `pass` on this thread's share of colour `colour`'s
   // blocks.
   void ApplyToBlocks(Pass pass, int colour, int thread, int threads);
+  // Whether this step's constraints are in blocks (simd_lanes, and some).
+  bool HasBlocks() const { return lanes_ && block_start_.back() > 0; }
   // f(blocks) with this step's layout's vector of blocks.
   template <typename F>
   void WithBlocks(const F& f) {
@@ -149,10 +151,9 @@ class SoftContactSolver {
   std::vector<std::uint8_t> colour_of_;
   bool lanes_ = true;            // SoftStepSettings::simd_lanes
   int compact_blocks_from_ = 0;  // SoftStepSettings::compact_blocks_from
-  // The blocks, this step's first block_count_ of blocks_ or (compact_) of
-  // compact_blocks_; each vector only grows, so a layout met again is
-  // not allocated again.
-  std::size_t block_count_ = 0;
+  // The blocks, this step's first block_start_.back() of blocks_ or
+  // (compact_) of compact_blocks_; each vector only grows, so a layout met
+  // again is not allocated again.
   bool compact_ = false;
   std::vector<SoftLaneBlock> blocks_;
   std::vector<CompactSoftLaneBlock> compact_blocks_;
