@@ -310,9 +310,14 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
   Constraint c;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
-    const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+    // Named copies, not a structured binding: C++17 lambdas cannot capture
+    // a binding (clang refuses it).
+    const std::pair<std::size_t, std::size_t> share =
+        Share(block_start_[colour + 1] - first_block, thread, threads);
+    const std::size_t begin = first_block + share.first;
+    const std::size_t end = first_block + share.second;
     WithBlocks([&](const auto& blocks) {
-      for (std::size_t b = first_block + begin; b < first_block + end; ++b) {
+      for (std::size_t b = begin; b < end; ++b) {
         for (int lane = 0; lane < blocks[b].lanes; ++lane) {
           ExtractSoftConstraint(blocks[b], lane, /*rows=*/bounce, &c);
           if (bounce) Restitute(&c);
@@ -385,10 +390,13 @@ void SoftContactSolver::ApplyToBlocks(Pass pass, int colour, int thread, int thr
   context.max_push_velocity = max_push_velocity_;
   context.collision_velocity_threshold = collision_velocity_threshold_;
   const std::size_t first_block = block_start_[colour];
-  const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+  const std::pair<std::size_t, std::size_t> share =
+      Share(block_start_[colour + 1] - first_block, thread, threads);
+  const std::size_t begin = first_block + share.first;
+  const std::size_t end = first_block + share.second;
   WithBlocks([&](auto& blocks) {
-    auto* const from = blocks.data() + first_block + begin;
-    auto* const to = blocks.data() + first_block + end;
+    auto* const from = blocks.data() + begin;
+    auto* const to = blocks.data() + end;
     if (pass == Pass::kWarmStart) {
       WarmStartSoftBlocks(context, from, to);
     } else if (SolveSoftBlocks(context, pass == Pass::kSolve, from, to)) {

@@ -60,7 +60,7 @@ struct PairVisit {
 };
 
 // The public methods do what World's of the same name are documented to do.
-class WorldImpl : public LinkBodies {
+class WorldImpl final : public LinkBodies {
  public:
   explicit WorldImpl(const WorldSettings& settings);
 
