@@ -41,6 +41,9 @@ int MeshSlotShape(const std::vector<ShapeDef>& shapes, int owner, int slot) {
 }
 
 int CallerShape(const std::vector<ShapeDef>& shapes, int shape) {
+  // A body of one shape has no slot copies (a mesh brings kContactSlots - 1):
+  // its shape is the caller's, with no shape read.
+  if (shapes.size() == 1) return shape;
   const int callers = CallerShapeCount(shapes);
   if (shape < callers) return shape;
   int ordinal = (shape - callers) / (StaticMesh::kContactSlots - 1);

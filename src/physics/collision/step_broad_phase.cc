@@ -36,37 +36,57 @@ ProxyKind KindOf(const Body& body) {
   return body.awake ? ProxyKind::kDynamic : ProxyKind::kSleeping;
 }
 
+// A body's proxy box: a moving body's is swept over the step's predicted
+// motion, x + dt v + dt^2 g / 2, so that pairs exist before the surfaces
+// meet (and fast bodies cannot skip them), and fattened by the margin and
+// the turn dt |w| r; any other body's by the margin alone.
+Aabb ProxyBox(Body* body, const StepContext& step, const WorldSettings& settings) {
+  Aabb box = BodyAabb(body);
+  if (KindOf(*body) != ProxyKind::kDynamic) return box.Fattened(settings.contact_margin);
+  const Vec3 motion = step.dt * body->linear_velocity + 0.5 * step.dt * step.dt * settings.gravity;
+  box = box.Union(Aabb{box.min + motion, box.max + motion});
+  return box.Fattened(settings.contact_margin +
+                      step.dt * body->angular_velocity.norm() * body->bounding_radius);
+}
+
+// Bodies a thread takes at a time: a box costs tens of ns.
+constexpr std::size_t kBoxesPerChunk = 128;
+
 }  // namespace
 
+// The bodies that need a box this step are listed in slot order; their
+// boxes are made on the pool (a box reads its own body and writes only that
+// body's support hints), then handed to the broad phase in the same order,
+// so the proxies and their pairs do not depend on the thread count.
 void WorldImpl::UpdateBroadPhase(const StepContext& step) {
-  const double margin = settings_.contact_margin;
+  proxy_bodies_.clear();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
-    Body& body = bodies_[i];
+    const Body& body = bodies_[i];
     if (!body.in_use || body.disabled || body.shapes.empty() ||
         std::holds_alternative<HalfSpace>(body.shapes.front().geometry)) {
       continue;
     }
     const ProxyKind kind = KindOf(body);
-    const bool moving = kind == ProxyKind::kDynamic;
-    if (body.has_proxy && !moving && broad_phase_.GetKind(static_cast<int>(i)) == kind) continue;
-    Aabb box = BodyAabb(&body);
-    if (moving) {
-      // The box swept over the predicted motion of the step, so that pairs
-      // exist before the surfaces meet (and fast bodies cannot skip them).
-      const Vec3 motion =
-          step.dt * body.linear_velocity + 0.5 * step.dt * step.dt * settings_.gravity;
-      box = box.Union(Aabb{box.min + motion, box.max + motion});
-      box = box.Fattened(margin + step.dt * body.angular_velocity.norm() * body.bounding_radius);
-    } else {
-      box = box.Fattened(margin);
+    if (body.has_proxy && kind != ProxyKind::kDynamic &&
+        broad_phase_.GetKind(static_cast<int>(i)) == kind) {
+      continue;
     }
+    proxy_bodies_.push_back(i);
+  }
+  proxy_boxes_.resize(proxy_bodies_.size());
+  step.pool->ParallelFor(proxy_bodies_.size(), kBoxesPerChunk, [&](std::size_t k) {
+    proxy_boxes_[k] = ProxyBox(&bodies_[proxy_bodies_[k]], step, settings_);
+  });
+  for (std::size_t k = 0; k < proxy_bodies_.size(); ++k) {
+    const auto id = static_cast<int>(proxy_bodies_[k]);
+    Body& body = bodies_[proxy_bodies_[k]];
+    const ProxyKind kind = KindOf(body);
     if (!body.has_proxy) {
-      broad_phase_.AddProxyWithId(static_cast<int>(i), box, kind,
-                                  articulations_.CollisionGroup(body));
+      broad_phase_.AddProxyWithId(id, proxy_boxes_[k], kind, articulations_.CollisionGroup(body));
       body.has_proxy = true;
     } else {
-      broad_phase_.SetAabb(static_cast<int>(i), box);
-      broad_phase_.SetKind(static_cast<int>(i), kind);
+      broad_phase_.SetAabb(id, proxy_boxes_[k]);
+      broad_phase_.SetKind(id, kind);
     }
   }
   broad_phase_.Update();

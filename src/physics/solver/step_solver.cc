@@ -142,8 +142,11 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
     const ShapePairContact* pair = pairs[m];
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
+    // Reset field by field: assigning a fresh SolverManifold built all four
+    // points (648 bytes) and copied them. Points past point_count keep an
+    // earlier step's values; nothing reads them.
     SolverManifold& manifold = manifolds[m];
-    manifold = SolverManifold();
+    manifold.tangent_world = {Vec3::UnitX(), Vec3::UnitY()};  // as constructed
     manifold.body_a = pair->body_a;
     manifold.body_b = pair->body_b;
     manifold.normal_world = pair->manifold.normal_world;
@@ -155,6 +158,7 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
     for (int i = 0; i < manifold.point_count; ++i) {
       const ContactPoint& contact = pair->manifold.points[i];
       SolverPoint& point = manifold.points[i];
+      point = SolverPoint();
       point.r_a = contact.position_world - a.position;
       point.r_b = contact.position_world - b.position;
       point.separation = contact.separation;
@@ -172,7 +176,7 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
 void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
                                bool impacts_only) {
   const std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  if (!impacts_only) ReportSleepingContacts(step);
+  const std::size_t first_report = impacts_only ? contacts_.size() : ReportSleepingContacts(step);
   // A collision is reported only where an impulse resolved it; a sub-step
   // after an impact reports only its collisions, the step's own report
   // holding the resting contacts.
@@ -196,9 +200,11 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
     for (int i = 0; i < manifold.point_count; ++i) reports += reported(manifold.points[i]) ? 1 : 0;
     report_offsets_[m + 1] = reports;
   });
-  report_offsets_[0] = static_cast<std::uint32_t>(contacts_.size());
+  report_offsets_[0] = static_cast<std::uint32_t>(first_report);
   for (std::size_t m = 0; m < count; ++m) report_offsets_[m + 1] += report_offsets_[m];
-  const std::size_t first_report = contacts_.size();
+  // One resize to the new length: the last step's reports past the sleeping
+  // ones are overwritten below, not constructed afresh first (constructing
+  // a report costs about what writing it does).
   contacts_.resize(report_offsets_[count]);
   step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
@@ -232,8 +238,9 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
 
 // Sleeping bodies keep the contacts they fell asleep with; their reports are
 // made again only when the list of sleeping pairs changes, and the reports
-// of this step follow them.
-void WorldImpl::ReportSleepingContacts(const StepContext& step) {
+// of this step follow them. Returns their count: contacts_ keeps its length
+// until ReportContacts resizes it.
+std::size_t WorldImpl::ReportSleepingContacts(const StepContext& step) {
   if (sleeping_reports_version_ != contact_cache_.sleeping_version()) {
     contacts_.clear();
     for (const ShapePairContact* pair : contact_cache_.sleeping()) {
@@ -246,7 +253,7 @@ void WorldImpl::ReportSleepingContacts(const StepContext& step) {
     sleeping_reports_version_ = contact_cache_.sleeping_version();
     sleeping_report_count_ = contacts_.size();
   }
-  contacts_.resize(sleeping_report_count_);
+  return sleeping_report_count_;
 }
 
 }  // namespace rigid_body_sim::physics

@@ -143,7 +143,7 @@ class WorldImpl final : public LinkBodies {
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
   void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
                       bool impacts_only);
-  void ReportSleepingContacts(const StepContext& step);
+  std::size_t ReportSleepingContacts(const StepContext& step);
   // The pair's manifold clipped afresh at the current poses (step_narrow_phase.cc).
   void RecollidePair(const StepContext& step, ShapePairContact* pair);
   // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
@@ -192,6 +192,8 @@ class WorldImpl final : public LinkBodies {
   double time_ = 0.0;
   std::uint64_t step_count_ = 0;
   SortAndSweepBroadPhase broad_phase_;
+  std::vector<std::uint32_t> proxy_bodies_;       // stage 1's: the bodies whose box is made
+  std::vector<Aabb> proxy_boxes_;                 // stage 1's, per proxy_bodies_ entry
   std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
   ContactCache contact_cache_;
   bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3
