@@ -1,14 +1,18 @@
 // PairIndex against std::unordered_map, the reference: the same random
 // inserts, erases and lookups must give the same answers, through growth
-// and long runs of backward-shift deletions.
+// and long runs of backward-shift deletions. And the contact cache's key
+// sort (SortByPairKey) against std::sort, its reference.
 #include "physics/collision/pair_index.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <unordered_map>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "physics/contact/contact_cache.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -60,6 +64,37 @@ TEST(PairIndexTest, AgreesWithUnorderedMapUnderRandomChurn) {
   index.Clear();
   EXPECT_EQ(index.size(), 0u);
   for (const auto& [key, value] : reference) EXPECT_EQ(index.Find(key), nullptr);
+}
+
+// Distinct keys laid out as the cache's (body A << 44 | body B << 24 |
+// shapes), in random, reversed and sorted order, with bodies that have one
+// pair, many pairs or none: the counting sort gives std::sort's order.
+TEST(PairIndexTest, SortByPairKeyGivesStdSortsOrder) {
+  std::mt19937_64 random(11);
+  std::vector<KeyedPair> scratch;
+  std::vector<std::uint32_t> starts;
+  for (const std::size_t count : {0u, 1u, 2u, 7u, 300u, 5000u}) {
+    for (const std::uint64_t bodies : {1u, 3u, 1000u, (1u << 20) - 1}) {
+      std::vector<std::uint64_t> keys;
+      for (std::size_t k = 0; k < count; ++k) {
+        keys.push_back(((random() % bodies) << 44) | ((random() % bodies) << 24) |
+                       (random() % 4096) << 12 | random() % 4096);
+      }
+      std::sort(keys.begin(), keys.end());
+      keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+      std::vector<KeyedPair> expected;
+      for (const std::uint64_t key : keys) {
+        expected.emplace_back(key, reinterpret_cast<ShapePairContact*>(key + 1));
+      }
+      for (int order = 0; order < 3; ++order) {
+        std::vector<KeyedPair> keyed = expected;
+        if (order == 0) std::shuffle(keyed.begin(), keyed.end(), random);
+        if (order == 1) std::reverse(keyed.begin(), keyed.end());
+        SortByPairKey(&keyed, &scratch, &starts);
+        ASSERT_EQ(keyed, expected) << count << " keys, " << bodies << " bodies, order " << order;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -10,7 +10,30 @@ namespace {
 // when their features differ. Resting points move far less in a step.
 constexpr double kPositionMatchDistance = 1e-3;
 
+// A key's body A: its top 20 bits (ContactCache::Key).
+constexpr int kBodyAShift = 44;
+
 }  // namespace
+
+void SortByPairKey(std::vector<KeyedPair>* keyed, std::vector<KeyedPair>* scratch,
+                   std::vector<std::uint32_t>* starts) {
+  if (keyed->size() < 2) return;
+  std::uint64_t last_body = 0;
+  for (const KeyedPair& pair : *keyed) last_body = std::max(last_body, pair.first >> kBodyAShift);
+  // starts[b + 1] counts body b's pairs, then their sums place each body.
+  starts->assign(last_body + 2, 0);
+  for (const KeyedPair& pair : *keyed) ++(*starts)[(pair.first >> kBodyAShift) + 1];
+  for (std::size_t b = 1; b < starts->size(); ++b) (*starts)[b] += (*starts)[b - 1];
+  scratch->resize(keyed->size());
+  for (const KeyedPair& pair : *keyed) (*scratch)[(*starts)[pair.first >> kBodyAShift]++] = pair;
+  for (std::size_t i = 1; i < scratch->size(); ++i) {
+    const KeyedPair pair = (*scratch)[i];
+    std::size_t k = i;
+    for (; k > 0 && pair.first < (*scratch)[k - 1].first; --k) (*scratch)[k] = (*scratch)[k - 1];
+    (*scratch)[k] = pair;
+  }
+  keyed->swap(*scratch);
+}
 
 // Each point of this step's manifold takes the impulses of last step's point
 // with the same features, else of the nearest unmatched one; a pair with no
@@ -64,7 +87,7 @@ void MatchWarmStarts(ShapePairContact* entry) {
 std::uint64_t ContactCache::Key(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
                                 std::uint16_t shape_b) {
   assert(body_a < (1u << 20) && body_b < (1u << 20) && shape_a < 4096 && shape_b < 4096);
-  return (std::uint64_t{body_a} << 44) | (std::uint64_t{body_b} << 24) |
+  return (std::uint64_t{body_a} << kBodyAShift) | (std::uint64_t{body_b} << 24) |
          (std::uint64_t{shape_a} << 12) | std::uint64_t{shape_b};
 }
 
@@ -154,8 +177,7 @@ void ContactCache::ListTouching() {
   // The solver's Gauss-Seidel order is the key order (body A's index first),
   // whatever order the pairs were visited in. The keys sit next to the
   // pointers, so the sort does not chase them.
-  std::sort(keyed_.begin(), keyed_.end(),
-            [](const auto& x, const auto& y) { return x.first < y.first; });
+  SortByPairKey(&keyed_, &sorted_, &body_starts_);
   for (const auto& [key, entry] : keyed_) touching_.push_back(entry);
   if (frozen_changed_) ListSleeping();
 }

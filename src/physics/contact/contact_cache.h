@@ -125,6 +125,9 @@ inline void PrefetchAhead(const std::vector<ShapePairContact*>& entries, std::si
   }
 }
 
+// A contact cache entry with its key (ContactCache::Key).
+using KeyedPair = std::pair<std::uint64_t, ShapePairContact*>;
+
 class ContactCache {
  public:
   // Starts loading what a Touch of the pair will read, some visits before
@@ -190,11 +193,24 @@ class ContactCache {
   std::vector<ShapePairContact*> touching_;
   std::vector<ShapePairContact*> seen_;     // after Prune, every entry of pairs_
   std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
-  std::vector<std::pair<std::uint64_t, ShapePairContact*>> keyed_;  // scratch of ListTouching
+  // ListTouching's scratch.
+  std::vector<KeyedPair> keyed_;
+  std::vector<KeyedPair> sorted_;
+  std::vector<std::uint32_t> body_starts_;
   std::vector<const ShapePairContact*> sleeping_;
   std::uint64_t sleeping_version_ = 0;
   bool frozen_changed_ = false;  // frozen_ differs from sleeping_
 };
+
+// Sorts (key, entry) pairs by ContactCache's keys, which are distinct and
+// begin with body A's index (its top 20 bits): a counting sort on body A,
+// then an insertion sort, whose moves stay within one body's few pairs.
+// O(n + bodies) work instead of a comparison sort's O(n log n), and the
+// same order as std::sort. Distribution counting: Knuth, The Art of
+// Computer Programming, vol. 3, 2nd ed., 1998, section 5.2, Algorithm D.
+// `scratch` and `starts` keep their memory for the next call.
+void SortByPairKey(std::vector<KeyedPair>* keyed, std::vector<KeyedPair>* scratch,
+                   std::vector<std::uint32_t>* starts);
 
 // Each point of `entry`'s manifold takes last step's impulses of the point
 // with the same features, else of the nearest unmatched one (warm start); a
