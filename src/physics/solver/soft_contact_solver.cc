@@ -45,19 +45,6 @@ double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
 }  // namespace
 
-// Starts loading the manifolds and friction anchors of the block of
-// constraints from `first` (before `end`): the colouring's order visits the
-// manifolds out of their own, and pyramid_90's 12,000 take 7.8 MB, more
-// than the caches hold, so each Prepare (and each Store) waited for its
-// manifold's lines.
-void SoftContactSolver::PrefetchManifolds(std::uint32_t first, std::uint32_t end) const {
-  for (std::uint32_t k = first; k < std::min<std::uint32_t>(end, first + kBatchLanes); ++k) {
-    const std::uint32_t m = colouring_.order[k];
-    PrefetchBytes(&(*manifolds_)[m], sizeof(SolverManifold));
-    PrefetchBytes(&(*anchors_)[m], sizeof(FrictionAnchor));
-  }
-}
-
 // Each block's constraints are prepared into a scratch block of four, in
 // the cache, and packed from there: the lanes keep the only copy. Then this
 // thread's share of the overflow set is prepared into the constraints.
@@ -73,7 +60,6 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
       const std::uint32_t first = start[colour] + static_cast<std::uint32_t>(b * kBatchLanes);
       const int lanes =
           static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
-      PrefetchManifolds(first + kPrefetchBlocksAhead * kBatchLanes, start[colour + 1]);
       for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
       WithBlocks([&](auto& blocks) {
         PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks[first_block + b]);
@@ -330,13 +316,8 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
         Share(block_start_[colour + 1] - first_block, thread, threads);
     const std::size_t begin = first_block + share.first;
     const std::size_t end = first_block + share.second;
-    const std::uint32_t colour_end = colouring_.colour_start[colour + 1];
     WithBlocks([&](const auto& blocks) {
       for (std::size_t b = begin; b < end; ++b) {
-        PrefetchManifolds(
-            colouring_.colour_start[colour] +
-                static_cast<std::uint32_t>((b - first_block + kPrefetchBlocksAhead) * kBatchLanes),
-            colour_end);
         for (int lane = 0; lane < blocks[b].lanes; ++lane) {
           ExtractSoftConstraint(blocks[b], lane, /*rows=*/bounce, &c);
           if (bounce) Restitute(&c);

@@ -115,10 +115,6 @@ class SoftContactSolver {
   void ListBlocks();
   template <typename PrepareConstraint>
   void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
-  void PrefetchManifolds(std::uint32_t first, std::uint32_t end) const;
-  // Blocks ahead of the one being prepared whose manifolds start loading:
-  // a block's Prepare takes about as long as a load from memory.
-  static constexpr std::uint32_t kPrefetchBlocksAhead = 2;
   void StoreBlocks(bool bounce, int thread, int threads, SpinBarrier* barrier);
   // The lane updates of `pass` on this thread's share of colour `colour`'s
   // blocks.
