@@ -55,14 +55,15 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
   std::array<Constraint, kBatchLanes> scratch;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
-    const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+    const auto [begin, end] = ColourBlocks(colour, thread, threads);
     for (std::size_t b = begin; b < end; ++b) {
-      const std::uint32_t first = start[colour] + static_cast<std::uint32_t>(b * kBatchLanes);
+      const std::uint32_t first =
+          start[colour] + static_cast<std::uint32_t>((b - first_block) * kBatchLanes);
       const int lanes =
           static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
       for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
       WithBlocks([&](auto& blocks) {
-        PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks[first_block + b]);
+        PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks[b]);
       });
     }
   }
@@ -309,13 +310,11 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
 void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBarrier* barrier) {
   Constraint c;
   for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
-    const std::size_t first_block = block_start_[colour];
     // Named copies, not a structured binding: C++17 lambdas cannot capture
     // a binding (clang refuses it).
-    const std::pair<std::size_t, std::size_t> share =
-        Share(block_start_[colour + 1] - first_block, thread, threads);
-    const std::size_t begin = first_block + share.first;
-    const std::size_t end = first_block + share.second;
+    const std::pair<std::size_t, std::size_t> share = ColourBlocks(colour, thread, threads);
+    const std::size_t begin = share.first;
+    const std::size_t end = share.second;
     WithBlocks([&](const auto& blocks) {
       for (std::size_t b = begin; b < end; ++b) {
         for (int lane = 0; lane < blocks[b].lanes; ++lane) {
@@ -359,6 +358,13 @@ void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier*
   barrier->Wait();
 }
 
+std::pair<std::size_t, std::size_t> SoftContactSolver::ColourBlocks(int colour, int thread,
+                                                                    int threads) const {
+  const std::size_t first_block = block_start_[colour];
+  const auto [begin, end] = Share(block_start_[colour + 1] - first_block, thread, threads);
+  return {first_block + begin, first_block + end};
+}
+
 // Four consecutive constraints of a colour to a block, the colour's last
 // block holding what is left; none without simd_lanes. From
 // compact_blocks_from blocks on, the blocks are compact: the passes stream
@@ -389,11 +395,9 @@ void SoftContactSolver::ApplyToBlocks(Pass pass, int colour, int thread, int thr
   context.h = h_;
   context.max_push_velocity = max_push_velocity_;
   context.collision_velocity_threshold = collision_velocity_threshold_;
-  const std::size_t first_block = block_start_[colour];
-  const std::pair<std::size_t, std::size_t> share =
-      Share(block_start_[colour + 1] - first_block, thread, threads);
-  const std::size_t begin = first_block + share.first;
-  const std::size_t end = first_block + share.second;
+  const std::pair<std::size_t, std::size_t> share = ColourBlocks(colour, thread, threads);
+  const std::size_t begin = share.first;
+  const std::size_t end = share.second;
   WithBlocks([&](auto& blocks) {
     auto* const from = blocks.data() + begin;
     auto* const to = blocks.data() + end;

@@ -26,6 +26,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "physics/contact/contact_cache.h"
@@ -119,6 +120,8 @@ class SoftContactSolver {
   // The lane updates of `pass` on this thread's share of colour `colour`'s
   // blocks.
   void ApplyToBlocks(Pass pass, int colour, int thread, int threads);
+  // This thread's share [begin, end) of colour `colour`'s blocks.
+  std::pair<std::size_t, std::size_t> ColourBlocks(int colour, int thread, int threads) const;
   // Whether this step's constraints are in blocks (simd_lanes, and some).
   bool HasBlocks() const { return lanes_ && block_start_.back() > 0; }
   // f(blocks) with this step's layout's vector of blocks.
