@@ -45,9 +45,30 @@ double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
 }  // namespace
 
+// Starts loading what preparing constraints [first, end) of the colouring's
+// order reads: their manifolds and friction anchors, or (bodies) the two
+// bodies of each, whose indices the manifolds hold.
+void SoftContactSolver::PrefetchPrepare(std::uint32_t first, std::uint32_t end, bool bodies) const {
+  for (std::uint32_t k = first; k < end; ++k) {
+    const std::uint32_t m = colouring_.order[k];
+    if (!bodies) {
+      PrefetchBytes(&(*manifolds_)[m], sizeof(SolverManifold));
+      PrefetchBytes(&(*anchors_)[m], sizeof(FrictionAnchor));
+      continue;
+    }
+    const SolverManifold& manifold = (*manifolds_)[m];
+    PrefetchBytes(&(*bodies_)[manifold.body_a], sizeof(SoftBody));
+    PrefetchBytes(&(*bodies_)[manifold.body_b], sizeof(SoftBody));
+  }
+}
+
 // Each block's constraints are prepared into a scratch block of four, in
 // the cache, and packed from there: the lanes keep the only copy. Then this
 // thread's share of the overflow set is prepared into the constraints.
+// Past the cache (compact_), the colouring's order reads the manifolds out
+// of their own order, and each Prepare waited for its manifold's lines: so
+// the manifolds of the block kManifoldsAhead blocks on start loading, and
+// the bodies of the one kBodiesAhead on, whose manifolds have arrived.
 template <typename PrepareConstraint>
 void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
                                              const PrepareConstraint& prepare) {
@@ -61,6 +82,14 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
           start[colour] + static_cast<std::uint32_t>((b - first_block) * kBatchLanes);
       const int lanes =
           static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
+      if (compact_) {
+        const std::uint32_t colour_end = start[colour + 1];
+        auto ahead = [&](std::uint32_t blocks) {
+          return std::min<std::uint32_t>(colour_end, first + blocks * kBatchLanes);
+        };
+        PrefetchPrepare(ahead(kManifoldsAhead), ahead(kManifoldsAhead + 1), /*bodies=*/false);
+        PrefetchPrepare(ahead(kBodiesAhead), ahead(kBodiesAhead + 1), /*bodies=*/true);
+      }
       for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
       WithBlocks([&](auto& blocks) {
         PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks[b]);
