@@ -24,6 +24,53 @@ constexpr std::size_t kMaxCollisionLogSize = 100000;
 // and the contacts reported on the pool.
 constexpr std::size_t kManifoldsPerChunk = 256;
 
+// Writes the reports of one pair's points. What they share (the bodies with
+// their generations, and the caller's shapes, which a static mesh's slot
+// copies map back) is looked up once a pair instead of once a point.
+class PairReporter {
+ public:
+  // `tangent` is the basis of the pair's normal (TangentBasis) that its
+  // cached impulses are in.
+  PairReporter(const ShapePairContact& pair, const std::array<Vec3, 2>& tangent,
+               const std::vector<Body>& bodies, const StepContext& step)
+      : pair_(pair),
+        tangent_(tangent),
+        body_a_{pair.body_a, bodies[pair.body_a].generation},
+        body_b_{pair.body_b, bodies[pair.body_b].generation},
+        shape_a_(CallerShape(bodies[pair.body_a].shapes, pair.shape_a)),
+        shape_b_(CallerShape(bodies[pair.body_b].shapes, pair.shape_b)),
+        dt_(step.dt) {}
+
+  // Every field of point i's report, as a resting contact with the pair's
+  // cached impulses.
+  void Write(int i, ContactReport* report) const {
+    const ContactPoint& contact = pair_.manifold.points[i];
+    const CachedImpulse& impulse = pair_.previous[i];
+    report->body_a = body_a_;
+    report->body_b = body_b_;
+    report->shape_a = shape_a_;
+    report->shape_b = shape_b_;
+    report->position_world = contact.position_world;
+    report->normal_world = pair_.manifold.normal_world;
+    report->depth = std::max(0.0, -contact.separation);
+    report->normal_velocity = 0.0;
+    report->type = ContactType::kResting;
+    report->normal_impulse = impulse.normal_impulse;
+    report->friction_impulse_world =
+        impulse.tangent_impulse[0] * tangent_[0] + impulse.tangent_impulse[1] * tangent_[1];
+    report->normal_force = report->normal_impulse / dt_;
+  }
+
+ private:
+  const ShapePairContact& pair_;
+  const std::array<Vec3, 2>& tangent_;
+  BodyId body_a_;
+  BodyId body_b_;
+  int shape_a_;
+  int shape_b_;
+  double dt_;  // s
+};
+
 }  // namespace
 
 // A resting report of point i of a pair from its cached impulses, with
@@ -32,22 +79,8 @@ constexpr std::size_t kManifoldsPerChunk = 256;
 ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
                                     const std::array<Vec3, 2>& tangent,
                                     const StepContext& step) const {
-  const ContactPoint& contact = pair.manifold.points[i];
-  const CachedImpulse& impulse = pair.previous[i];
   ContactReport report;
-  report.body_a = BodyId{pair.body_a, bodies_[pair.body_a].generation};
-  report.body_b = BodyId{pair.body_b, bodies_[pair.body_b].generation};
-  // A static mesh's slot copies report as the mesh (mesh_collision.h).
-  report.shape_a = CallerShape(bodies_[pair.body_a].shapes, pair.shape_a);
-  report.shape_b = CallerShape(bodies_[pair.body_b].shapes, pair.shape_b);
-  report.position_world = contact.position_world;
-  report.normal_world = pair.manifold.normal_world;
-  report.depth = std::max(0.0, -contact.separation);
-  report.type = ContactType::kResting;
-  report.normal_impulse = impulse.normal_impulse;
-  report.friction_impulse_world =
-      impulse.tangent_impulse[0] * tangent[0] + impulse.tangent_impulse[1] * tangent[1];
-  report.normal_force = report.normal_impulse / step.dt;
+  PairReporter(pair, tangent, bodies_, step).Write(i, &report);
   return report;
 }
 
@@ -212,6 +245,7 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
     ShapePairContact& pair = *pairs[m];
     pair.previous_count = manifold.point_count;
     std::uint32_t next = report_offsets_[m];
+    const PairReporter reporter(pair, manifold.tangent_world, bodies_, step);
     for (int i = 0; i < manifold.point_count; ++i) {
       const SolverPoint& point = manifold.points[i];
       pair.previous[i] =
@@ -220,7 +254,7 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
                         point.preload,         point.carried_approach};
       if (!reported(point)) continue;
       ContactReport& report = contacts_[next++];
-      report = MakeReport(pair, i, manifold.tangent_world, step);
+      reporter.Write(i, &report);
       report.normal_velocity = point.normal_velocity_before;
       report.type = point.type;
       report.normal_impulse = point.collision_impulse + point.normal_impulse;
