@@ -2,6 +2,7 @@
 // sort-and-sweep broad phase, which returns the candidate pairs.
 #include <variant>
 
+#include "physics/dynamics/body_frames.h"
 #include "physics/geometry/shape_bounds.h"
 #include "physics/world/world_impl.h"
 
@@ -20,11 +21,13 @@ Aabb BodyAabb(Body* body) {
       if (polyhedron != nullptr) body->box_support[i] = (*polyhedron)->axis_support;
     }
   }
-  const Pose world_from_body = body->WorldFromBody();
+  const Pose world_from_body =
+      ComposeUnlessIdentity(body->WorldFromPrincipal(), body->principal_from_body);
   Aabb box;
   for (std::size_t i = 0; i < body->shapes.size(); ++i) {
     const Aabb shape_box =
-        ShapeAabb(body->shapes[i].geometry, world_from_body * body->shapes[i].body_from_shape,
+        ShapeAabb(body->shapes[i].geometry,
+                  ComposeUnlessIdentity(world_from_body, body->shapes[i].body_from_shape),
                   &body->box_support[i]);
     box = i == 0 ? shape_box : box.Union(shape_box);
   }

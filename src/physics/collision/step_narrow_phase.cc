@@ -6,6 +6,7 @@
 
 #include "physics/collision/mesh_collision.h"
 #include "physics/collision/narrow_phase.h"
+#include "physics/dynamics/body_frames.h"
 #include "physics/geometry/shape_bounds.h"
 #include "physics/world/world_impl.h"
 
@@ -346,8 +347,8 @@ void WorldImpl::CollideShapePair(NarrowJob* job) const {
   const ShapeDef& shape_a = a.shapes[entry.shape_a];
   const ShapeDef& shape_b = b.shapes[entry.shape_b];
   const Pose b_from_a = b.WorldFromPrincipal().Inverse() * a.WorldFromPrincipal();
-  const Pose world_from_shape_a = a.WorldFromBody() * shape_a.body_from_shape;
-  const Pose world_from_shape_b = b.WorldFromBody() * shape_b.body_from_shape;
+  const Pose world_from_shape_a = WorldFromShape(a, shape_a);
+  const Pose world_from_shape_b = WorldFromShape(b, shape_b);
   if (ReuseManifold(b_from_a, a.bounding_radius, world_from_shape_a, world_from_shape_b, &entry)) {
     job->reused = true;
     MatchWarmStarts(&entry);
@@ -376,9 +377,9 @@ void WorldImpl::RecollidePair(const StepContext& step, ShapePairContact* pair) {
   const ShapeDef& shape_b = b.shapes[pair->shape_b];
   CollideInput input;
   input.a = &shape_a.geometry;
-  input.world_from_a = a.WorldFromBody() * shape_a.body_from_shape;
+  input.world_from_a = WorldFromShape(a, shape_a);
   input.b = &shape_b.geometry;
-  input.world_from_b = b.WorldFromBody() * shape_b.body_from_shape;
+  input.world_from_b = WorldFromShape(b, shape_b);
   input.contact_distance = ContactDistance(a, b, step);
   pair->contact_distance = input.contact_distance;
   CollideStats stats;
