@@ -190,9 +190,9 @@ struct CylinderAxis {
   Kind kind = Kind::kPoints;
   Vec3 normal = Vec3::UnitZ();
   double separation = -std::numeric_limits<double>::infinity();
-  int face = -1;  // kFaceB
-  Vec3 point_a;   // kPoints: on the cylinder
-  Vec3 point_b;   // kPoints: on the polyhedron
+  int face = -1;                // kFaceB
+  Vec3 point_a = Vec3::Zero();  // kPoints: on the cylinder
+  Vec3 point_b = Vec3::Zero();  // kPoints: on the polyhedron
 };
 
 struct PolyhedronInWorld {
@@ -266,15 +266,11 @@ CylinderAxis BestAxis(const CylinderPair& pair, const WorldCylinder& cylinder,
   };
   const ConvexPolyhedron& shape = *polyhedron.shape;
   for (int f = 0; f < static_cast<int>(shape.faces.size()); ++f) {
-    consider({CylinderAxis::Kind::kFaceB,
-              pair.world_from_other.rotation * shape.faces[f].normal,
-              0.0,
-              f,
-              {},
-              {}});
+    consider({CylinderAxis::Kind::kFaceB, pair.world_from_other.rotation * shape.faces[f].normal,
+              0.0, f, Vec3::Zero(), Vec3::Zero()});
   }
-  consider({CylinderAxis::Kind::kCap, cylinder.axis, 0.0, -1, {}, {}});
-  consider({CylinderAxis::Kind::kCap, -cylinder.axis, 0.0, -1, {}, {}});
+  consider({CylinderAxis::Kind::kCap, cylinder.axis, 0.0, -1, Vec3::Zero(), Vec3::Zero()});
+  consider({CylinderAxis::Kind::kCap, -cylinder.axis, 0.0, -1, Vec3::Zero(), Vec3::Zero()});
   const Cylinder local{cylinder.radius, cylinder.half_length};
   const Pose& world_from_cylinder = pair.world_from_cylinder;
   const Pose cylinder_from_world = world_from_cylinder.Inverse();
