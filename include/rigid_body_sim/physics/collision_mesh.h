@@ -40,7 +40,7 @@ class CollisionMesh {
     // the triangle across it, oriented as this one (this triangle's own
     // normal for a boundary or non-manifold edge), and the edge's fold seen
     // from the side `normal` points to.
-    std::array<Vec3, 3> neighbour_normals{};
+    std::array<Vec3, 3> neighbour_normals{Vec3::UnitZ(), Vec3::UnitZ(), Vec3::UnitZ()};
     std::array<EdgeFold, 3> edge_folds{};
   };
 
