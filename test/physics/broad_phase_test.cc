@@ -1,9 +1,11 @@
 #include "physics/collision/broad_phase.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -475,6 +477,33 @@ TEST(SortAndSweepBroadPhaseTest, MatchesBruteForceOver500StepsOf2000Boxes) {
   // pair per box (mean box 0.625 m on a side in a 12 m cube: 2000 boxes see
   // 2000 * 1999 / 2 * (1.25 / 12)^3 ~ 2260 overlapping pairs).
   EXPECT_GT(total_pairs / kSteps, 1000u);
+}
+
+// SortPairKeys is the broad phase's fast sort; std::sort is its reference.
+// Distinct keys a << 32 | b with a < b, from ids below a bound that takes
+// the counting sorts, and with one id far past it, which takes std::sort.
+TEST(SortPairKeysTest, GivesStdSortsOrder) {
+  std::mt19937_64 random(7);
+  for (const std::uint32_t id_bound : {2u, 50u, 4000u, 4000000u}) {
+    std::uniform_int_distribution<std::uint32_t> id(0, id_bound - 1);
+    std::set<std::uint64_t> unique;
+    for (int k = 0; k < 3000; ++k) {
+      std::uint32_t a = id(random);
+      std::uint32_t b = id(random);
+      if (a == b) continue;
+      if (b < a) std::swap(a, b);
+      unique.insert((std::uint64_t{a} << 32) | b);
+    }
+    std::vector<std::uint64_t> keys(unique.begin(), unique.end());
+    std::shuffle(keys.begin(), keys.end(), random);
+    std::vector<std::uint64_t> expected = keys;
+    std::sort(expected.begin(), expected.end());
+    SortPairKeys(&keys);
+    EXPECT_EQ(keys, expected) << "ids below " << id_bound;
+  }
+  std::vector<std::uint64_t> none;
+  SortPairKeys(&none);
+  EXPECT_TRUE(none.empty());
 }
 
 }  // namespace

@@ -408,10 +408,40 @@ void SortAndSweepBroadPhase::ErasePair(std::uint64_t key) {
   if (pairs_.erase(key) > 0) sorted_pairs_stale_ = true;
 }
 
+namespace {
+
+// keys stably sorted into *sorted by the 32 bits at `shift`, each below m.
+void CountingSortBy(const std::vector<std::uint64_t>& keys, int shift, std::uint64_t m,
+                    std::vector<std::uint32_t>* counts, std::vector<std::uint64_t>* sorted) {
+  counts->assign(m + 1, 0);
+  for (const std::uint64_t key : keys) ++(*counts)[((key >> shift) & 0xffffffffu) + 1];
+  for (std::uint64_t d = 0; d < m; ++d) (*counts)[d + 1] += (*counts)[d];
+  sorted->resize(keys.size());
+  for (const std::uint64_t key : keys) (*sorted)[(*counts)[(key >> shift) & 0xffffffffu]++] = key;
+}
+
+}  // namespace
+
+// A settling pile's pairs change every step, and std::sort of them was 1.7 %
+// of pile_4000's step (perf, one thread).
+void SortPairKeys(std::vector<std::uint64_t>* keys) {
+  std::uint64_t largest = 0;
+  for (const std::uint64_t key : *keys) largest = std::max(largest, key >> 32);
+  for (const std::uint64_t key : *keys) largest = std::max(largest, key & 0xffffffffu);
+  if (largest > 4 * keys->size() + 1024) {
+    std::sort(keys->begin(), keys->end());
+    return;
+  }
+  std::vector<std::uint32_t> counts;
+  std::vector<std::uint64_t> by_b;
+  CountingSortBy(*keys, 0, largest + 1, &counts, &by_b);
+  CountingSortBy(by_b, 32, largest + 1, &counts, keys);
+}
+
 const std::vector<ProxyPair>& SortAndSweepBroadPhase::Pairs() const {
   if (!sorted_pairs_stale_) return sorted_pairs_;
   std::vector<std::uint64_t> keys(pairs_.begin(), pairs_.end());
-  std::sort(keys.begin(), keys.end());
+  SortPairKeys(&keys);
   sorted_pairs_.clear();
   sorted_pairs_.reserve(keys.size());
   for (std::uint64_t key : keys) {
