@@ -55,14 +55,14 @@ struct ProxyState {
   std::uint32_t group = 0;
 };
 
-// Incremental sort-and-sweep broad phase.
-//
 // Sorts distinct pair keys (a << 32 | b) ascending, as std::sort would: two
 // stable counting sorts, by b and then by a (least significant digit first),
 // in O(n + m) for ids below m, against std::sort's O(n log n). With an id
 // past 4 n + 1024 the counts would outgrow the keys, and std::sort is used.
 void SortPairKeys(std::vector<std::uint64_t>* keys);
 
+// Incremental sort-and-sweep broad phase.
+//
 // Usage per step: SetAabb() for the proxies that moved (and AddProxy,
 // RemoveProxy, SetKind as needed), then Update(), then read Pairs().
 //
