@@ -45,18 +45,20 @@ double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
 }  // namespace
 
-// Starts loading what preparing constraints [first, end) of the colouring's
-// order reads: their manifolds and friction anchors, or (bodies) the two
-// bodies of each, whose indices the manifolds hold.
-void SoftContactSolver::PrefetchPrepare(std::uint32_t first, std::uint32_t end, bool bodies) const {
+// Start loading what preparing constraints [first, end) of the colouring's
+// order reads: their manifolds and friction anchors, and then, once those
+// have arrived, the two bodies whose indices the manifolds hold.
+void SoftContactSolver::PrefetchManifolds(std::uint32_t first, std::uint32_t end) const {
   for (std::uint32_t k = first; k < end; ++k) {
     const std::uint32_t m = colouring_.order[k];
-    if (!bodies) {
-      PrefetchBytes(&(*manifolds_)[m], sizeof(SolverManifold));
-      PrefetchBytes(&(*anchors_)[m], sizeof(FrictionAnchor));
-      continue;
-    }
-    const SolverManifold& manifold = (*manifolds_)[m];
+    PrefetchBytes(&(*manifolds_)[m], sizeof(SolverManifold));
+    PrefetchBytes(&(*anchors_)[m], sizeof(FrictionAnchor));
+  }
+}
+
+void SoftContactSolver::PrefetchBodies(std::uint32_t first, std::uint32_t end) const {
+  for (std::uint32_t k = first; k < end; ++k) {
+    const SolverManifold& manifold = (*manifolds_)[colouring_.order[k]];
     PrefetchBytes(&(*bodies_)[manifold.body_a], sizeof(SoftBody));
     PrefetchBytes(&(*bodies_)[manifold.body_b], sizeof(SoftBody));
   }
@@ -87,8 +89,8 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
         auto ahead = [&](std::uint32_t blocks) {
           return std::min<std::uint32_t>(colour_end, first + blocks * kBatchLanes);
         };
-        PrefetchPrepare(ahead(kManifoldsAhead), ahead(kManifoldsAhead + 1), /*bodies=*/false);
-        PrefetchPrepare(ahead(kBodiesAhead), ahead(kBodiesAhead + 1), /*bodies=*/true);
+        PrefetchManifolds(ahead(kManifoldsAhead), ahead(kManifoldsAhead + 1));
+        PrefetchBodies(ahead(kBodiesAhead), ahead(kBodiesAhead + 1));
       }
       for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
       WithBlocks([&](auto& blocks) {

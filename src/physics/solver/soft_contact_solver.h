@@ -116,7 +116,8 @@ class SoftContactSolver {
   void ListBlocks();
   template <typename PrepareConstraint>
   void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
-  void PrefetchPrepare(std::uint32_t first, std::uint32_t end, bool bodies) const;
+  void PrefetchManifolds(std::uint32_t first, std::uint32_t end) const;
+  void PrefetchBodies(std::uint32_t first, std::uint32_t end) const;
   // Blocks ahead of the one being prepared whose manifolds, and whose
   // bodies, start loading (pyramid_90 on one thread: 0.95 of the awake step
   // without; docs/performance.md).
