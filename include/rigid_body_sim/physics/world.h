@@ -105,7 +105,9 @@ class World {
   Status SetJointCommand(ArticulationId id, int joint, const JointCommand& command);
   Status SetServoGains(ArticulationId id, const ServoGains& gains);
 
-  // The contact points of the last step.
+  // The contact points of the last step. They are written by the first
+  // call after the step, so a step whose reports nobody reads does not
+  // write them; that call, though const, must not race another call.
   const std::vector<ContactReport>& contacts() const;
   // The colliding contacts of every step since the last call, so that short
   // impacts are not lost between two reads.

@@ -95,6 +95,8 @@ void ExactSolver::ResolveImpacts(const StepContext& step, const std::vector<Impa
     }
   }
   for (const std::uint32_t body : moving) paths_[body] = BodyPath{};
+  // The sub-steps collide their pairs and build their manifolds afresh.
+  if (!islands.empty()) world_.FlushReports();
   for (std::size_t k = 0; k < islands.size(); ++k) {
     const double rest = step.dt - island_times[k];
     if (rest > 0.0) SubStep(islands[k], step.Interval(rest), round + 1);

@@ -79,6 +79,7 @@ void WorldImpl::GuardAfterStep() {
 }
 
 void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal) {
+  FlushReports();
   Body& body = bodies_[index];
   body.position = world_from_principal.translation;
   body.orientation = world_from_principal.rotation;

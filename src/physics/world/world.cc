@@ -1,4 +1,7 @@
-// World forwards to WorldImpl, which holds the stages' state.
+// World forwards to WorldImpl, which holds the stages' state. The calls
+// that may change the pairs or the bodies' slots that the last step's
+// contact reports are made of write those reports first
+// (WorldImpl::FlushReports): a report is written when it is first read.
 #include "rigid_body_sim/physics/world.h"
 
 #include "physics/world/world_impl.h"
@@ -11,10 +14,19 @@ World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
 
 const WorldSettings& World::settings() const { return impl_->settings(); }
-Status World::SetSettings(const WorldSettings& settings) { return impl_->SetSettings(settings); }
+Status World::SetSettings(const WorldSettings& settings) {
+  impl_->FlushReports();
+  return impl_->SetSettings(settings);
+}
 
-Result<BodyId> World::CreateBody(const BodyDef& def) { return impl_->CreateBody(def); }
-Status World::DestroyBody(BodyId id) { return impl_->DestroyBody(id); }
+Result<BodyId> World::CreateBody(const BodyDef& def) {
+  impl_->FlushReports();
+  return impl_->CreateBody(def);
+}
+Status World::DestroyBody(BodyId id) {
+  impl_->FlushReports();
+  return impl_->DestroyBody(id);
+}
 bool World::IsValid(BodyId id) const { return impl_->IsValid(id); }
 std::size_t World::BodyCount() const { return impl_->BodyCount(); }
 std::size_t World::AwakeBodyCount() const { return impl_->AwakeBodyCount(); }
@@ -24,6 +36,7 @@ Vec3 World::GetLinearVelocity(BodyId id) const { return impl_->GetLinearVelocity
 Vec3 World::GetAngularVelocity(BodyId id) const { return impl_->GetAngularVelocity(id); }
 Status World::SetState(BodyId id, const Pose& world_from_body, const Vec3& linear_velocity,
                        const Vec3& angular_velocity) {
+  impl_->FlushReports();
   return impl_->SetState(id, world_from_body, linear_velocity, angular_velocity);
 }
 const Body& World::GetBody(BodyId id) const { return impl_->GetBody(id); }
@@ -49,9 +62,13 @@ const std::vector<ContactReport>& World::contacts() const { return impl_->contac
 std::vector<ContactReport> World::TakeCollisionLog() { return impl_->TakeCollisionLog(); }
 
 Result<ArticulationId> World::CreateArticulation(const ArticulationDef& def) {
+  impl_->FlushReports();
   return impl_->CreateArticulation(def);
 }
-Status World::DestroyArticulation(ArticulationId id) { return impl_->DestroyArticulation(id); }
+Status World::DestroyArticulation(ArticulationId id) {
+  impl_->FlushReports();
+  return impl_->DestroyArticulation(id);
+}
 bool World::IsValid(ArticulationId id) const { return impl_->IsValid(id); }
 std::vector<BodyId> World::ArticulationLinks(ArticulationId id) const {
   return impl_->ArticulationLinks(id);
@@ -61,6 +78,7 @@ std::vector<JointState> World::GetJointStates(ArticulationId id) const {
 }
 Status World::SetJointStates(ArticulationId id, const std::vector<double>& positions,
                              const std::vector<double>& velocities) {
+  impl_->FlushReports();
   return impl_->SetJointStates(id, positions, velocities);
 }
 Status World::SetJointCommand(ArticulationId id, int joint, const JointCommand& command) {

@@ -257,6 +257,7 @@ Status WorldImpl::ApplyTorque(BodyId id, const Vec3& torque_world) {
 
 void WorldImpl::Restart() {
   time_ = 0.0;
+  pending_reports_.pending = false;
   contacts_.clear();
   collision_log_.clear();
   contact_cache_.Clear();
@@ -286,6 +287,7 @@ void WorldImpl::RestartSleepWindow(std::uint32_t index) {
 }
 
 void WorldImpl::WakeTouching(std::uint32_t index) {
+  FlushReports();
   for (const ContactReport& contact : contacts_) {
     if (contact.body_a.index != index && contact.body_b.index != index) continue;
     for (const BodyId other : {contact.body_a, contact.body_b}) {
@@ -305,6 +307,9 @@ std::vector<ContactReport> WorldImpl::TakeCollisionLog() {
 void WorldImpl::Step() {
   const StepContext step(settings_, pool_.get());
   non_finite_bodies_.clear();
+  // The last step's reports that nobody read are never written: this
+  // step's take their place.
+  pending_reports_.pending = false;
   // Wall time since the previous lap, ms; steady_clock costs tens of
   // nanoseconds a read, nothing next to a stage.
   std::chrono::steady_clock::time_point lap_start = std::chrono::steady_clock::now();

@@ -88,7 +88,16 @@ class WorldImpl final : public LinkBodies {
   const StepProfile& last_step_profile() const { return last_step_profile_; }
   void Restart();
   const std::vector<BodyId>& non_finite_bodies() const { return non_finite_bodies_; }
-  const std::vector<ContactReport>& contacts() const { return contacts_; }
+  // The last step's reports, written first if they are not yet
+  // (ReportContacts).
+  const std::vector<ContactReport>& contacts() {
+    FlushReports();
+    return contacts_;
+  }
+  // Writes the reports ReportContacts left to be written when read: before
+  // contacts_ is read, and before a call changes the pairs or the bodies'
+  // slots they are made of.
+  void FlushReports();
   std::vector<ContactReport> TakeCollisionLog();
 
   // Articulations (articulation/articulation_system.h).
@@ -144,6 +153,8 @@ class WorldImpl final : public LinkBodies {
   void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
                       bool impacts_only);
   std::size_t ReportSleepingContacts(const StepContext& step);
+  void WriteReports(std::size_t m, const std::vector<ShapePairContact*>& pairs, double dt,
+                    bool impacts_only);
   // The pair's manifold clipped afresh at the current poses (step_narrow_phase.cc).
   void RecollidePair(const StepContext& step, ShapePairContact* pair);
   // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
@@ -212,8 +223,18 @@ class WorldImpl final : public LinkBodies {
   } sleep_scratch_;
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
-  // ReportContacts' scratch: where each manifold's reports start.
+  // ReportContacts' scratch: where each manifold's reports start, and
+  // whether they hold a collision (those are written at once).
   std::vector<std::uint32_t> report_offsets_;
+  std::vector<std::uint8_t> report_collided_;
+  // What FlushReports needs of the last ReportContacts: its pairs (the
+  // touching pairs without a link, rigid_pairs_), its step and its kind.
+  struct PendingReports {
+    const std::vector<ShapePairContact*>* pairs = nullptr;
+    double dt = 0.0;  // s
+    bool impacts_only = false;
+    bool pending = false;  // some reports are not written yet
+  } pending_reports_;
   std::vector<BodyId> non_finite_bodies_;
   std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
   StepProfile last_step_profile_;
