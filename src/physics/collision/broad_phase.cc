@@ -245,6 +245,8 @@ void SortAndSweepBroadPhase::RemoveDeadEndpoints() {
 void SortAndSweepBroadPhase::RebuildFromScratch() {
   pairs_.clear();
   sorted_pairs_stale_ = true;
+  changes_complete_ = false;
+  changed_pairs_.clear();
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<Endpoint>& list = endpoints_[axis];
     for (Endpoint& endpoint : list) {
@@ -401,11 +403,24 @@ void SortAndSweepBroadPhase::Update() {
 }
 
 void SortAndSweepBroadPhase::AddPair(std::uint64_t key) {
-  if (pairs_.insert(key).second) sorted_pairs_stale_ = true;
+  if (pairs_.insert(key).second) NoteChangedPair(key);
 }
 
 void SortAndSweepBroadPhase::ErasePair(std::uint64_t key) {
-  if (pairs_.erase(key) > 0) sorted_pairs_stale_ = true;
+  if (pairs_.erase(key) > 0) NoteChangedPair(key);
+}
+
+// Past as many changes as pairs, Pairs() sorts them all again: merging
+// would cost more, and the log stays bounded when Pairs() is not called.
+void SortAndSweepBroadPhase::NoteChangedPair(std::uint64_t key) {
+  sorted_pairs_stale_ = true;
+  if (!changes_complete_) return;
+  if (changed_pairs_.size() > pairs_.size() + 1024) {
+    changes_complete_ = false;
+    changed_pairs_.clear();
+    return;
+  }
+  changed_pairs_.push_back(key);
 }
 
 namespace {
@@ -439,18 +454,66 @@ void SortPairKeys(std::vector<std::uint64_t>* keys) {
   CountingSortBy(by_b, 32, largest + 1, &counts, keys);
 }
 
+namespace {
+
+ProxyPair PairOfKey(std::uint64_t key) {
+  return ProxyPair{static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)};
+}
+
+std::uint64_t KeyOfPair(const ProxyPair& pair) {
+  return std::uint64_t{static_cast<std::uint32_t>(pair.first)} << 32 |
+         static_cast<std::uint32_t>(pair.second);
+}
+
+}  // namespace
+
 const std::vector<ProxyPair>& SortAndSweepBroadPhase::Pairs() const {
   if (!sorted_pairs_stale_) return sorted_pairs_;
-  std::vector<std::uint64_t> keys(pairs_.begin(), pairs_.end());
-  SortPairKeys(&keys);
-  sorted_pairs_.clear();
-  sorted_pairs_.reserve(keys.size());
-  for (std::uint64_t key : keys) {
-    sorted_pairs_.push_back(
-        ProxyPair{static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)});
+  if (changes_complete_) {
+    MergeChangedPairs();
+  } else {
+    std::vector<std::uint64_t> keys(pairs_.begin(), pairs_.end());
+    SortPairKeys(&keys);
+    sorted_pairs_.clear();
+    sorted_pairs_.reserve(keys.size());
+    for (std::uint64_t key : keys) sorted_pairs_.push_back(PairOfKey(key));
   }
+  changed_pairs_.clear();
+  changes_complete_ = true;
   sorted_pairs_stale_ = false;
   return sorted_pairs_;
+}
+
+// A merge of two sorted lists: the old pairs whose key did not change, and
+// the changed keys that pairs_ holds now (a key added and erased again
+// since is in neither). O(n + k log k) for k changes, in the order a full
+// sort gives.
+void SortAndSweepBroadPhase::MergeChangedPairs() const {
+  std::sort(changed_pairs_.begin(), changed_pairs_.end());
+  changed_pairs_.erase(std::unique(changed_pairs_.begin(), changed_pairs_.end()),
+                       changed_pairs_.end());
+  merged_pairs_.clear();
+  merged_pairs_.reserve(pairs_.size());
+  std::size_t c = 0;
+  auto take_changed_below = [&](std::uint64_t bound) {
+    for (; c < changed_pairs_.size() && changed_pairs_[c] < bound; ++c) {
+      const std::uint64_t changed = changed_pairs_[c];
+      if (pairs_.count(changed) > 0) merged_pairs_.push_back(PairOfKey(changed));
+    }
+  };
+  for (const ProxyPair& pair : sorted_pairs_) {
+    const std::uint64_t key = KeyOfPair(pair);
+    take_changed_below(key);
+    if (c < changed_pairs_.size() && changed_pairs_[c] == key) {
+      if (pairs_.count(key) > 0) merged_pairs_.push_back(pair);
+      ++c;
+    } else {
+      merged_pairs_.push_back(pair);
+    }
+  }
+  // No key is all ones: a pair's first id is below its second.
+  take_changed_below(~std::uint64_t{0});
+  sorted_pairs_.swap(merged_pairs_);
 }
 
 bool SortAndSweepBroadPhase::HasPair(int a, int b) const {
