@@ -1,6 +1,7 @@
 // Stage 5's end, for both solvers: bodies whose state is not finite are
 // disabled, and quiet islands are put to sleep.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -61,6 +62,36 @@ bool WorldImpl::UpdateSpeedingUp(const StepContext& step, Body* body) const {
   return sleep.speeding_up_time > 0.0 && body->speeding_up_time >= sleep.speeding_up_time;
 }
 
+// How long an awake body has been quiet (slow and not speeding up, or
+// within its sleep window), s; 0 in an island with a link. It updates the
+// body's sleep_time and speed history and its sleep window.
+double WorldImpl::QuietTime(const StepContext& step, const SleepWindowLimits& limits,
+                            bool island_has_link, std::uint32_t i) {
+  const SleepSettings& sleep = settings_.sleep;
+  Body& body = bodies_[i];
+  if (!body.awake) return std::numeric_limits<double>::infinity();
+  const bool speeding_up = UpdateSpeedingUp(step, &body);
+  if (island_has_link) {
+    // Held by, resting on or pushed by a link: its quiet time starts
+    // over, so that once the link lets go it must be quiet for
+    // time_to_sleep again; counted on, a box held still for a second fell
+    // asleep in mid-air the step the gripper opened.
+    body.sleep_time = 0.0;
+    RestartSleepWindow(i);
+    return 0.0;
+  }
+  const bool slow =
+      !speeding_up &&
+      body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
+      body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
+  body.sleep_time = slow ? body.sleep_time + step.dt : 0.0;
+  // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
+  if (speeding_up) RestartSleepWindow(i);
+  const double still_time =
+      UpdateSleepWindow(body.WorldFromPrincipal(), limits, step.dt, &sleep_windows_[i]);
+  return std::max(body.sleep_time, still_time);
+}
+
 // Islands are the connected components of the contact graph through moving
 // bodies (union-find). An island sleeps when every body in it has been slower
 // than the thresholds, or has kept within its sleep window, and not speeding
@@ -71,11 +102,21 @@ void WorldImpl::UpdateSleep(const StepContext& step) {
   // The islands' scratch keeps its memory from step to step.
   UnionFind& islands = sleep_scratch_.islands;
   islands.Reset(bodies_.size());
-  for (const ShapePairContact* pair : contact_cache_.touching()) {
-    const Body& a = bodies_[pair->body_a];
-    const Body& b = bodies_[pair->body_b];
-    if (a.is_static || b.is_static) continue;
-    islands.Join(pair->body_a, pair->body_b);
+  // The touching pairs' bodies are read out of their cache entries on the
+  // pool (each entry, and each body, a load the caches no longer hold), and
+  // joined here from the list.
+  const std::vector<ShapePairContact*>& touching = contact_cache_.touching();
+  std::vector<std::array<std::uint32_t, 2>>& edges = sleep_scratch_.edges;
+  edges.resize(touching.size());
+  constexpr std::size_t kPairsPerChunk = 256;
+  step.pool->ParallelFor(touching.size(), kPairsPerChunk, [&](std::size_t m) {
+    const ShapePairContact& pair = *touching[m];
+    const bool joins = !bodies_[pair.body_a].is_static && !bodies_[pair.body_b].is_static;
+    edges[m] = joins ? std::array<std::uint32_t, 2>{pair.body_a, pair.body_b}
+                     : std::array<std::uint32_t, 2>{pair.body_a, pair.body_a};
+  });
+  for (const std::array<std::uint32_t, 2>& edge : edges) {
+    if (edge[0] != edge[1]) islands.Join(edge[0], edge[1]);
   }
   // Articulations never sleep, nor does what touches them.
   std::vector<char>& island_has_link = sleep_scratch_.island_has_link;
@@ -88,39 +129,29 @@ void WorldImpl::UpdateSleep(const StepContext& step) {
   std::vector<double>& island_sleep_time = sleep_scratch_.island_sleep_time;
   island_sleep_time.assign(bodies_.size(), std::numeric_limits<double>::infinity());
   sleep_windows_.resize(bodies_.size());
+  // Each moving body's island, found here because Find compresses paths;
+  // then each body's quiet time on the pool (it reads and writes only its
+  // own body and window), and each island's, their least, here.
+  std::vector<std::uint32_t>& root = sleep_scratch_.root;
+  std::vector<double>& quiet_time = sleep_scratch_.quiet_time;
+  root.resize(moving_bodies_.size());
+  quiet_time.resize(moving_bodies_.size());
+  for (std::size_t k = 0; k < moving_bodies_.size(); ++k) root[k] = islands.Find(moving_bodies_[k]);
   const SleepWindowLimits limits =
       MakeSleepWindowLimits(sleep.linear_velocity, sleep.angular_velocity, sleep.time_to_sleep);
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
-    if (!body.awake) continue;
-    const bool speeding_up = UpdateSpeedingUp(step, &body);
-    if (island_has_link[islands.Find(i)]) {
-      // Held by, resting on or pushed by a link: its quiet time starts
-      // over, so that once the link lets go it must be quiet for
-      // time_to_sleep again; counted on, a box held still for a second fell
-      // asleep in mid-air the step the gripper opened.
-      body.sleep_time = 0.0;
-      RestartSleepWindow(i);
-      island_sleep_time[islands.Find(i)] = 0.0;
-      continue;
-    }
-    const bool slow =
-        !speeding_up &&
-        body.linear_velocity.squaredNorm() < sleep.linear_velocity * sleep.linear_velocity &&
-        body.angular_velocity.squaredNorm() < sleep.angular_velocity * sleep.angular_velocity;
-    body.sleep_time = slow ? body.sleep_time + step.dt : 0.0;
-    // Slow for long enough, or gone nowhere for long enough (sleep_window.h).
-    if (speeding_up) RestartSleepWindow(i);
-    const double still_time =
-        UpdateSleepWindow(body.WorldFromPrincipal(), limits, step.dt, &sleep_windows_[i]);
-    const double quiet_time = std::max(body.sleep_time, still_time);
-    double& island = island_sleep_time[islands.Find(i)];
-    island = std::min(island, quiet_time);
+  constexpr std::size_t kBodiesPerChunk = 128;
+  step.pool->ParallelFor(moving_bodies_.size(), kBodiesPerChunk, [&](std::size_t k) {
+    quiet_time[k] = QuietTime(step, limits, island_has_link[root[k]] != 0, moving_bodies_[k]);
+  });
+  // A body asleep already is quiet for ever, and changes no island's time.
+  for (std::size_t k = 0; k < moving_bodies_.size(); ++k) {
+    double& island = island_sleep_time[root[k]];
+    island = std::min(island, quiet_time[k]);
   }
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
+  for (std::size_t k = 0; k < moving_bodies_.size(); ++k) {
+    if (island_sleep_time[root[k]] < sleep.time_to_sleep) continue;
+    Body& body = bodies_[moving_bodies_[k]];
     if (!body.awake) continue;
-    if (island_sleep_time[islands.Find(i)] < sleep.time_to_sleep) continue;
     body.awake = false;
     body.linear_momentum.setZero();
     body.angular_momentum.setZero();

@@ -27,6 +27,8 @@ class SoftStepSolver final : public MotionSolver {
 
   // A chunk of the pool's per-body loops: a body costs tens of ns.
   static constexpr std::size_t kBodiesPerChunk = 128;
+  // A chunk of the pool's per-pair copies of friction anchors.
+  static constexpr std::size_t kPairsPerChunk = 256;
 
   WorldImpl& world_;
   SoftContactSolver solver_;
@@ -57,14 +59,14 @@ void SoftStepSolver::Solve(const StepContext& step) {
   input.moving = &w.moving_bodies_;
   input.touch_tolerance =
       std::max(w.settings_.solver.contact_tolerance, 0.1 * w.settings_.contact_margin);
+  // The anchors to and from the pairs' cache entries on the pool: each
+  // entry is a load from memory the caches no longer hold.
   anchors_.resize(w.rigid_pairs_.size());
-  for (std::size_t m = 0; m < w.rigid_pairs_.size(); ++m) {
-    anchors_[m] = w.rigid_pairs_[m]->friction_anchor;
-  }
+  step.pool->ParallelFor(w.rigid_pairs_.size(), kPairsPerChunk,
+                         [&](std::size_t m) { anchors_[m] = w.rigid_pairs_[m]->friction_anchor; });
   solver_.Step(input, step.pool, &bodies_, &w.solver_.manifolds(), &anchors_);
-  for (std::size_t m = 0; m < w.rigid_pairs_.size(); ++m) {
-    w.rigid_pairs_[m]->friction_anchor = anchors_[m];
-  }
+  step.pool->ParallelFor(w.rigid_pairs_.size(), kPairsPerChunk,
+                         [&](std::size_t m) { w.rigid_pairs_[m]->friction_anchor = anchors_[m]; });
   StoreVelocities(step);
   w.DisableNonFiniteBodies();
   w.articulations_.Solve(step);

@@ -175,6 +175,8 @@ class WorldImpl final : public LinkBodies {
   // Stage 5's end, both solvers' (dynamics/step_sleep.cc).
   void UpdateSleep(const StepContext& step);
   bool UpdateSpeedingUp(const StepContext& step, Body* body) const;
+  double QuietTime(const StepContext& step, const SleepWindowLimits& limits, bool island_has_link,
+                   std::uint32_t i);
   void DisableNonFiniteBodies();
   void DisableBody(std::uint32_t index);
   // The step guard (step_guard.cc), around stages 1-5: bodies whose state
@@ -220,6 +222,9 @@ class WorldImpl final : public LinkBodies {
     UnionFind islands;
     std::vector<char> island_has_link;
     std::vector<double> island_sleep_time;
+    std::vector<std::array<std::uint32_t, 2>> edges;  // per touching pair: bodies to join
+    std::vector<std::uint32_t> root;                  // per moving body: its island
+    std::vector<double> quiet_time;                   // s, per moving body
   } sleep_scratch_;
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
