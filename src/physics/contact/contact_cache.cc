@@ -168,11 +168,19 @@ void ContactCache::Prune(std::uint64_t step, bool recheck_frozen,
   visited_.clear();
 }
 
-void ContactCache::ListTouching() {
+void ContactCache::ListTouching(TaskPool* pool) {
   touching_.clear();
   keyed_.clear();
-  for (ShapePairContact* entry : seen_) {
-    if (entry->manifold.point_count > 0) keyed_.emplace_back(entry->key, entry);
+  // The entries are read on the pool (each a load the caches no longer
+  // hold), the touching ones listed here from what they gave.
+  constexpr std::size_t kEntriesPerChunk = 256;
+  seen_keys_.resize(seen_.size());
+  pool->ParallelFor(seen_.size(), kEntriesPerChunk, [this](std::size_t m) {
+    ShapePairContact* entry = seen_[m];
+    seen_keys_[m] = KeyedPair{entry->key, entry->manifold.point_count > 0 ? entry : nullptr};
+  });
+  for (const KeyedPair& seen : seen_keys_) {
+    if (seen.second != nullptr) keyed_.push_back(seen);
   }
   // The solver's Gauss-Seidel order is the key order (body A's index first),
   // whatever order the pairs were visited in. The keys sit next to the

@@ -20,6 +20,7 @@
 
 #include "physics/collision/pair_index.h"
 #include "physics/contact/contact_manifold.h"
+#include "physics/world/task_pool.h"
 
 namespace rigid_body_sim::physics {
 
@@ -158,13 +159,13 @@ class ContactCache {
   // in the cache. Stage 3 in two parts: Prune drops the pairs not seen in
   // `step` unless `asleep` says both of their bodies sleep (their contacts
   // still hold, frozen), and lists the seen ones in seen(); ListTouching
-  // lists the touching pairs.
+  // lists the touching pairs, reading the entries on `pool`.
   // Frozen pairs are set aside and cost nothing per step; pass
   // `recheck_frozen` when a body woke or left since the last call, so that
   // frozen pairs of bodies no longer asleep go.
   void Prune(std::uint64_t step, bool recheck_frozen,
              const std::function<bool(const ShapePairContact&)>& asleep);
-  void ListTouching();
+  void ListTouching(TaskPool* pool);
   // Pairs with at least one contact point this step, in key order.
   const std::vector<ShapePairContact*>& touching() const { return touching_; }
   // Every pair the narrow phase looked at this step, touching or not, in
@@ -193,7 +194,9 @@ class ContactCache {
   std::vector<ShapePairContact*> touching_;
   std::vector<ShapePairContact*> seen_;     // after Prune, every entry of pairs_
   std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
-  // ListTouching's scratch.
+  // ListTouching's scratch: each seen entry's key, and the entry if it
+  // touches (else null); then the touching ones.
+  std::vector<KeyedPair> seen_keys_;
   std::vector<KeyedPair> keyed_;
   std::vector<KeyedPair> sorted_;
   std::vector<std::uint32_t> body_starts_;

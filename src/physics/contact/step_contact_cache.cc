@@ -13,14 +13,27 @@ void WorldImpl::UpdateContactCache() {
   });
   woke_since_prune_ = false;
   // The narrow phase has matched each seen pair's points with last step's.
-  contact_cache_.ListTouching();
-  for (const ShapePairContact* pair : contact_cache_.touching()) {
-    Body& a = bodies_[pair->body_a];
-    Body& b = bodies_[pair->body_b];
-    // Either side may be the sleeper: a link closing on a box that sleeps
-    // on the table, whatever their order in the pair.
-    if (!b.is_static && !b.awake && a.awake) Wake(pair->body_b);
-    if (!a.is_static && !a.awake && b.awake) Wake(pair->body_a);
+  contact_cache_.ListTouching(pool_.get());
+  // Either side may be the sleeper: a link closing on a box that sleeps on
+  // the table, whatever their order in the pair. The pairs with a sleeper
+  // are found on the pool; only they can wake a body, here, in the pairs'
+  // order, as a body woken by one pair wakes its sleeping partner in a
+  // later one (waking never puts a body to sleep).
+  const std::vector<ShapePairContact*>& touching = contact_cache_.touching();
+  auto sleeps = [](const Body& body) { return !body.is_static && !body.awake; };
+  has_sleeper_.resize(touching.size());
+  constexpr std::size_t kPairsPerChunk = 256;
+  pool_->ParallelFor(touching.size(), kPairsPerChunk, [&](std::size_t m) {
+    has_sleeper_[m] =
+        sleeps(bodies_[touching[m]->body_a]) || sleeps(bodies_[touching[m]->body_b]) ? 1 : 0;
+  });
+  for (std::size_t m = 0; m < touching.size(); ++m) {
+    if (has_sleeper_[m] == 0) continue;
+    const ShapePairContact& pair = *touching[m];
+    Body& a = bodies_[pair.body_a];
+    Body& b = bodies_[pair.body_b];
+    if (sleeps(b) && a.awake) Wake(pair.body_b);
+    if (sleeps(a) && b.awake) Wake(pair.body_a);
   }
 }
 

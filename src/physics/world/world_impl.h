@@ -232,6 +232,8 @@ class WorldImpl final : public LinkBodies {
   // whether they hold a collision (those are written at once).
   std::vector<std::uint32_t> report_offsets_;
   std::vector<std::uint8_t> report_collided_;
+  // UpdateContactCache's scratch: per touching pair, whether a body sleeps.
+  std::vector<std::uint8_t> has_sleeper_;
   // What FlushReports needs of the last ReportContacts: its pairs (the
   // touching pairs without a link, rigid_pairs_), its step and its kind.
   struct PendingReports {
