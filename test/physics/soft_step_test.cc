@@ -254,8 +254,6 @@ TEST(SoftStepTest, NewSupportsCarryTheirLoadWithNoMoment) {
   bodies[1].position = Vec3(0.0, 0.0, 0.1);
   bodies[2].mass = 1.0;
   bodies[2].position = Vec3(0.05, 0.0, 0.3);
-  std::vector<ShapePairContact> pairs(2);
-  std::vector<ShapePairContact*> pair_pointers = {&pairs[0], &pairs[1]};
   // Manifold 0: the lower box on the ground, its corners x, y = +-0.1.
   // Manifold 1: the upper box on the lower one, over x in [-0.05, 0.1].
   std::vector<SolverManifold> manifolds(2);
@@ -266,6 +264,7 @@ TEST(SoftStepTest, NewSupportsCarryTheirLoadWithNoMoment) {
     manifolds[m].body_a = m == 0 ? 1 : 2;
     manifolds[m].body_b = m == 0 ? 0 : 1;
     manifolds[m].point_count = 4;
+    manifolds[m].new_pair = true;  // both supports are new
     for (int i = 0; i < 4; ++i) {
       const Vec3 at((m == 0 ? xs0 : xs1)[i], ys[i], m == 0 ? 0.0 : 0.2);
       manifolds[m].points[i].r_a = at - bodies[manifolds[m].body_a].position;
@@ -274,7 +273,6 @@ TEST(SoftStepTest, NewSupportsCarryTheirLoadWithNoMoment) {
   }
   SupportBalanceInput input;
   input.bodies = &bodies;
-  input.pairs = &pair_pointers;
   input.gravity = Vec3(0.0, 0.0, -9.81);
   input.dt = 0.01;
   input.contact_tolerance = 1e-4;

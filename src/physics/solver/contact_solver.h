@@ -62,6 +62,7 @@ struct SolverManifold {
   double friction = 0.0;     // mu, combined
   double restitution = 0.0;  // e, combined
   int point_count = 0;
+  bool new_pair = false;  // its pair had no point last step
   std::array<SolverPoint, ContactManifold::kMaxPoints> points;
 };
 

@@ -89,7 +89,7 @@ void ExactSolver::SolveTouching(const StepContext& step,
   world_.solver_.Reset(world_.settings_.solver, step.dt, world_.bodies_.size());
   LoadVelocities(world_.bodies_, world_.moving_bodies_, pairs, &world_.solver_.bodies());
   world_.BuildSolverManifolds(pairs, step);
-  world_.SeedNewSupportLoads(pairs, step);
+  world_.SeedNewSupportLoads(step);
   world_.solver_.Prepare();
 
   world_.solver_.ResolveCollisions();

@@ -82,11 +82,11 @@ void SoftStepSolver::Solve(const StepContext& step) {
 // the load tracking catches up.
 void SoftStepSolver::SeedNewSupports(const StepContext& step) {
   WorldImpl& w = world_;
-  const std::vector<UprightSupport> supports = w.SeedNewSupportLoads(w.rigid_pairs_, step);
+  const std::vector<UprightSupport> supports = w.SeedNewSupportLoads(step);
   std::vector<SolverManifold>& manifolds = w.solver_.manifolds();
-  BalanceNewSupports(w.SupportInput(w.rigid_pairs_, step), supports, &manifolds);
+  BalanceNewSupports(w.SupportInput(step), supports, &manifolds);
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
-    if (w.rigid_pairs_[m]->previous_count != 0) continue;
+    if (!manifolds[m].new_pair) continue;
     for (int i = 0; i < manifolds[m].point_count; ++i) {
       manifolds[m].points[i].preload = manifolds[m].points[i].normal_impulse;
     }

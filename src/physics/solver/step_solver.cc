@@ -98,13 +98,11 @@ ContactReport WorldImpl::MakeReport(const ShapePairContact& pair, int i,
 // where the iteration starts: the complementarity conditions, and so the
 // solution, are the same. Returns the upright supports it walked (none when
 // no support is new), for the soft step's spread.
-std::vector<UprightSupport> WorldImpl::SeedNewSupportLoads(
-    const std::vector<ShapePairContact*>& pairs, const StepContext& step) {
+std::vector<UprightSupport> WorldImpl::SeedNewSupportLoads(const StepContext& step) {
   const double g = settings_.gravity.norm();
   if (g <= 0.0) return {};
   std::vector<SolverManifold>& manifolds = solver_.manifolds();
-  std::vector<UprightSupport> supports =
-      UprightSupportsHighestFirst(SupportInput(pairs, step), manifolds);
+  std::vector<UprightSupport> supports = UprightSupportsHighestFirst(SupportInput(step), manifolds);
   if (supports.empty()) return supports;
   // N s: a body's load; then, from its first support on, what its new
   // supports share.
@@ -143,11 +141,9 @@ std::vector<UprightSupport> WorldImpl::SeedNewSupportLoads(
   return supports;
 }
 
-SupportBalanceInput WorldImpl::SupportInput(const std::vector<ShapePairContact*>& pairs,
-                                            const StepContext& step) const {
+SupportBalanceInput WorldImpl::SupportInput(const StepContext& step) const {
   SupportBalanceInput input;
   input.bodies = &bodies_;
-  input.pairs = &pairs;
   input.gravity = settings_.gravity;
   input.dt = step.dt;
   input.contact_tolerance = settings_.solver.contact_tolerance;
@@ -189,6 +185,7 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
     manifold.friction = CombineFriction(material_a.friction, material_b.friction);
     manifold.restitution = CombineRestitution(material_a.restitution, material_b.restitution);
     manifold.point_count = pair->manifold.point_count;
+    manifold.new_pair = pair->previous_count == 0;
     for (int i = 0; i < manifold.point_count; ++i) {
       const ContactPoint& contact = pair->manifold.points[i];
       SolverPoint& point = manifold.points[i];

@@ -74,7 +74,7 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
   // supports need not be listed.
   bool any_new_pair = false;
   for (std::size_t m = 0; m < manifolds.size() && !any_new_pair; ++m) {
-    any_new_pair = (*input.pairs)[m]->previous_count == 0 && manifolds[m].point_count > 0;
+    any_new_pair = manifolds[m].new_pair && manifolds[m].point_count > 0;
   }
   if (!any_new_pair) return supports;
   const Vec3 up = -input.gravity / g;
@@ -85,7 +85,7 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
     const SolverManifold& manifold = manifolds[m];
     const double up_along_normal = manifold.normal_world.dot(up);  // the normal points to A
     if (std::abs(up_along_normal) <= kUpright || manifold.point_count == 0) continue;
-    bool is_new = (*input.pairs)[m]->previous_count == 0;
+    bool is_new = manifold.new_pair;
     for (int i = 0; i < manifold.point_count; ++i) {
       is_new &= manifold.points[i].separation <= input.contact_tolerance;
     }
@@ -100,15 +100,18 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
     supports.clear();
     return supports;
   }
-  // Ties by index, for the same order on every run.
+  // Ties by index, for the same order on every run. Each upper body's
+  // height is read once, not at every comparison (a body load each).
   const std::vector<Body>& bodies = *input.bodies;
-  const auto height = [&](std::uint32_t body) { return bodies[body].position.dot(up); };
-  std::sort(supports.begin(), supports.end(),
-            [&](const UprightSupport& x, const UprightSupport& y) {
-              const double hx = height(x.upper);
-              const double hy = height(y.upper);
-              return hx != hy ? hx > hy : x.upper < y.upper;
-            });
+  std::vector<std::pair<double, UprightSupport>> by_height;
+  by_height.reserve(supports.size());
+  for (const UprightSupport& support : supports) {
+    by_height.emplace_back(bodies[support.upper].position.dot(up), support);
+  }
+  std::sort(by_height.begin(), by_height.end(), [](const auto& x, const auto& y) {
+    return x.first != y.first ? x.first > y.first : x.second.upper < y.second.upper;
+  });
+  for (std::size_t k = 0; k < supports.size(); ++k) supports[k] = by_height[k].second;
   return supports;
 }
 

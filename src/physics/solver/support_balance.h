@@ -17,8 +17,6 @@ namespace rigid_body_sim::physics {
 
 struct SupportBalanceInput {
   const std::vector<Body>* bodies = nullptr;
-  // One per manifold: the pair it was built from (for previous_count).
-  const std::vector<ShapePairContact*>* pairs = nullptr;
   Vec3 gravity = Vec3::Zero();     // m/s^2
   double dt = 0.0;                 // s
   double contact_tolerance = 0.0;  // m: a point this close touches

@@ -185,11 +185,9 @@ class WorldImpl final : public LinkBodies {
   void GuardBeforeStep(const StepContext& step);
   void GuardAfterStep();
   void FreezeBody(std::uint32_t index, const Pose& world_from_principal);
-  // `pairs` are the touching pairs, one per solver manifold.
-  std::vector<UprightSupport> SeedNewSupportLoads(const std::vector<ShapePairContact*>& pairs,
-                                                  const StepContext& step);
-  SupportBalanceInput SupportInput(const std::vector<ShapePairContact*>& pairs,
-                                   const StepContext& step) const;
+  // On the solver manifolds (BuildSolverManifolds).
+  std::vector<UprightSupport> SeedNewSupportLoads(const StepContext& step);
+  SupportBalanceInput SupportInput(const StepContext& step) const;
   ContactReport MakeReport(const ShapePairContact& pair, int point,
                            const std::array<Vec3, 2>& tangent,
                            const StepContext& step) const override;
