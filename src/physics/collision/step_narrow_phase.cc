@@ -119,21 +119,7 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
   });
   narrow_jobs_.clear();
   for (std::size_t k = 0; k < pairs.size(); ++k) ListPair(pairs[k], pair_visits_[k], step);
-  for (const std::uint32_t plane : half_space_bodies_) {
-    const Pose world_from_plane =
-        bodies_[plane].WorldFromBody() * bodies_[plane].shapes.front().body_from_shape;
-    const Vec3 normal = world_from_plane.rotation * Vec3::UnitZ();
-    const double height = normal.dot(world_from_plane.translation);
-    for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
-      const Body& body = bodies_[i];
-      if (!body.in_use || body.is_static || !body.awake || body.shapes.empty()) continue;
-      // A body whose bounding sphere stays clear of the plane by the contact
-      // distance has no pair with it to look at.
-      const double clearance = normal.dot(body.position) - height - body.bounding_radius;
-      if (clearance >= ContactDistance(body, bodies_[plane], step)) continue;
-      CollideBodies(i, plane, step);
-    }
-  }
+  for (const std::uint32_t plane : half_space_bodies_) VisitPlane(plane, step);
   // The listed shape pairs are tested after the walk, on the pool: a test
   // reads the bodies' poses, which no stage-2 work changes, and writes its
   // own cache entry only, so the manifolds are the same whichever thread
@@ -145,6 +131,37 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
     CollideShapePair(&narrow_jobs_[j]);
   });
   for (const NarrowJob& job : narrow_jobs_) last_step_profile_.reused_manifolds += job.reused;
+}
+
+// The pairs of the half-space `plane` with the awake bodies near it, walked
+// as the broad phase's are: each body tested and each pair visited on the
+// pool, then listed here in the bodies' order.
+void WorldImpl::VisitPlane(std::uint32_t plane, const StepContext& step) {
+  const Pose world_from_plane =
+      bodies_[plane].WorldFromBody() * bodies_[plane].shapes.front().body_from_shape;
+  const Vec3 normal = world_from_plane.rotation * Vec3::UnitZ();
+  const double height = normal.dot(world_from_plane.translation);
+  near_plane_.resize(bodies_.size());
+  step.pool->ParallelFor(bodies_.size(), kVisitsPerChunk, [&](std::size_t i) {
+    const Body& body = bodies_[i];
+    near_plane_[i] = 0;
+    if (!body.in_use || body.is_static || !body.awake || body.shapes.empty()) return;
+    // A body whose bounding sphere stays clear of the plane by the contact
+    // distance has no pair with it to look at.
+    const double clearance = normal.dot(body.position) - height - body.bounding_radius;
+    near_plane_[i] = clearance < ContactDistance(body, bodies_[plane], step) ? 1 : 0;
+  });
+  plane_pairs_.clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (near_plane_[i]) plane_pairs_.push_back({static_cast<int>(i), static_cast<int>(plane)});
+  }
+  pair_visits_.resize(plane_pairs_.size());
+  step.pool->ParallelFor(plane_pairs_.size(), kVisitsPerChunk, [&](std::size_t k) {
+    VisitPair(plane_pairs_[k], step, &pair_visits_[k]);
+  });
+  for (std::size_t k = 0; k < plane_pairs_.size(); ++k) {
+    ListPair(plane_pairs_[k], pair_visits_[k], step);
+  }
 }
 
 // m; the margin plus the distance the two bodies can close in one step.

@@ -163,6 +163,7 @@ class WorldImpl final : public LinkBodies {
   // CollideBodies in two halves for a pair of single shapes (PairVisit).
   void VisitPair(ProxyPair pair, const StepContext& step, PairVisit* visit);
   void ListPair(ProxyPair pair, const PairVisit& visit, const StepContext& step);
+  void VisitPlane(std::uint32_t plane, const StepContext& step);
   // Tests one listed shape pair: carries its manifold or clips a new one.
   void CollideShapePair(NarrowJob* job) const;
   double ContactDistance(const Body& a, const Body& b, const StepContext& step) const;
@@ -195,9 +196,11 @@ class WorldImpl final : public LinkBodies {
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
   std::unique_ptr<MotionSolver> motion_solver_;  // settings_.motion_solver
-  std::vector<PairVisit> pair_visits_;           // stage 2's, per broad-phase pair
-  std::vector<NarrowJob> narrow_jobs_;           // stage 2's, in the order the pairs were visited
-  std::vector<Body> bodies_;                     // slots; a destroyed body's slot is reused
+  std::vector<PairVisit> pair_visits_;    // stage 2's, per broad-phase pair, then per plane pair
+  std::vector<std::uint8_t> near_plane_;  // VisitPlane's, per body slot
+  std::vector<ProxyPair> plane_pairs_;    // VisitPlane's: (body, plane)
+  std::vector<NarrowJob> narrow_jobs_;    // stage 2's, in the order the pairs were visited
+  std::vector<Body> bodies_;              // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;
   double time_ = 0.0;
