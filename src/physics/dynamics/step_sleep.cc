@@ -11,13 +11,18 @@
 
 namespace rigid_body_sim::physics {
 
-// Only moving bodies change state within a step, so only they are checked.
+// Only moving bodies change state within a step, so only they are checked,
+// on the pool; the few that fail are disabled here, in their order.
 void WorldImpl::DisableNonFiniteBodies() {
-  for (const std::uint32_t i : moving_bodies_) {
-    Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || body.disabled || body.HasFiniteState()) continue;
+  non_finite_.resize(moving_bodies_.size());
+  constexpr std::size_t kBodiesPerChunk = 256;
+  pool_->ParallelFor(moving_bodies_.size(), kBodiesPerChunk, [this](std::size_t k) {
+    const Body& body = bodies_[moving_bodies_[k]];
+    non_finite_[k] = body.in_use && !body.is_static && !body.disabled && !body.HasFiniteState();
+  });
+  for (std::size_t k = 0; k < moving_bodies_.size(); ++k) {
     // Its cached pairs are no longer seen from the next step on, and go.
-    DisableBody(i);
+    if (non_finite_[k]) DisableBody(moving_bodies_[k]);
   }
 }
 

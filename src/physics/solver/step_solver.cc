@@ -263,9 +263,11 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
   // ones are overwritten, not constructed afresh first (constructing a
   // report costs about what writing it does).
   contacts_.resize(report_offsets_[count]);
+  step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
+    if (report_collided_[m]) WriteReports(m, pairs, step.dt, impacts_only);
+  });
   for (std::size_t m = 0; m < count; ++m) {
     if (!report_collided_[m]) continue;
-    WriteReports(m, pairs, step.dt, impacts_only);
     for (std::uint32_t k = report_offsets_[m]; k < report_offsets_[m + 1]; ++k) {
       if (contacts_[k].type == ContactType::kColliding) collision_log_.push_back(contacts_[k]);
     }

@@ -52,15 +52,25 @@ bool StateIsSafe(const Body& body) {
 
 }  // namespace
 
+// Both guards test every body on the pool (a test reads its own body and
+// writes its own slot) and freeze the ones that failed here, in the
+// bodies' order; freezing one body changes no other body's test.
 void WorldImpl::GuardBeforeStep(const StepContext& step) {
   guard_start_poses_.resize(bodies_.size());
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
-    Body& body = bodies_[i];
+  guard_failed_.resize(bodies_.size());
+  step.pool->ParallelFor(bodies_.size(), kBodiesPerGuardChunk, [&](std::size_t i) {
+    const Body& body = bodies_[i];
+    guard_failed_[i] = 0;
     // A link's state is its articulation's, which guards it as a whole.
-    if (!body.in_use || body.is_static || body.disabled || body.articulation >= 0) continue;
+    if (!body.in_use || body.is_static || body.disabled || body.articulation >= 0) return;
     const bool pose_is_finite = body.position.allFinite() && IsFinite(body.orientation);
     if (pose_is_finite) guard_start_poses_[i] = body.WorldFromPrincipal();
-    if (!body.awake || StepIsSafe(body, step.dt)) continue;
+    guard_failed_[i] = body.awake && !StepIsSafe(body, step.dt) ? 1 : 0;
+  });
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (!guard_failed_[i]) continue;
+    const Body& body = bodies_[i];
+    const bool pose_is_finite = body.position.allFinite() && IsFinite(body.orientation);
     // A pose that is not finite cannot come from the API (it refuses one),
     // so the start of the step is the last finite pose there is.
     FreezeBody(i, pose_is_finite ? body.WorldFromPrincipal() : guard_start_poses_[i]);
@@ -68,13 +78,17 @@ void WorldImpl::GuardBeforeStep(const StepContext& step) {
 }
 
 void WorldImpl::GuardAfterStep() {
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+  guard_failed_.resize(bodies_.size());
+  pool_->ParallelFor(bodies_.size(), kBodiesPerGuardChunk, [&](std::size_t i) {
     const Body& body = bodies_[i];
-    if (!body.in_use || body.is_static || body.articulation >= 0) continue;
+    guard_failed_[i] = 0;
+    if (!body.in_use || body.is_static || body.articulation >= 0) return;
     // A body the stages disabled for a state that is not finite still holds
     // that state; one frozen here before holds a finite one.
-    if (body.disabled ? body.HasFiniteState() : StateIsSafe(body)) continue;
-    FreezeBody(i, guard_start_poses_[i]);
+    guard_failed_[i] = body.disabled ? !body.HasFiniteState() : !StateIsSafe(body);
+  });
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (guard_failed_[i]) FreezeBody(i, guard_start_poses_[i]);
   }
 }
 

@@ -244,7 +244,10 @@ class WorldImpl final : public LinkBodies {
     bool pending = false;  // some reports are not written yet
   } pending_reports_;
   std::vector<BodyId> non_finite_bodies_;
-  std::vector<Pose> guard_start_poses_;  // world_from_principal at the guard's start, per slot
+  std::vector<Pose> guard_start_poses_;     // world_from_principal at the guard's start, per slot
+  std::vector<std::uint8_t> guard_failed_;  // the guards' scratch, per slot
+  std::vector<std::uint8_t> non_finite_;    // DisableNonFiniteBodies', per moving body
+  static constexpr std::size_t kBodiesPerGuardChunk = 256;
   StepProfile last_step_profile_;
   std::vector<ShapePairContact*> rigid_pairs_;  // the touching pairs without a link
   ArticulationSystem articulations_{&bodies_, this};
