@@ -258,18 +258,25 @@ void WorldImpl::ReportContacts(const std::vector<ShapePairContact*>& pairs, cons
     report_collided_[m] = collided ? 1 : 0;
   });
   report_offsets_[0] = static_cast<std::uint32_t>(first_report);
-  for (std::size_t m = 0; m < count; ++m) report_offsets_[m + 1] += report_offsets_[m];
+  bool any_collided = false;
+  for (std::size_t m = 0; m < count; ++m) {
+    report_offsets_[m + 1] += report_offsets_[m];
+    any_collided |= report_collided_[m] != 0;
+  }
   // One resize to the new length: the last step's reports past the sleeping
   // ones are overwritten, not constructed afresh first (constructing a
   // report costs about what writing it does).
   contacts_.resize(report_offsets_[count]);
-  step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
-    if (report_collided_[m]) WriteReports(m, pairs, step.dt, impacts_only);
-  });
-  for (std::size_t m = 0; m < count; ++m) {
-    if (!report_collided_[m]) continue;
-    for (std::uint32_t k = report_offsets_[m]; k < report_offsets_[m + 1]; ++k) {
-      if (contacts_[k].type == ContactType::kColliding) collision_log_.push_back(contacts_[k]);
+  // Most steps of a settled scene have no collision.
+  if (any_collided) {
+    step.pool->ParallelFor(count, kManifoldsPerChunk, [&](std::size_t m) {
+      if (report_collided_[m]) WriteReports(m, pairs, step.dt, impacts_only);
+    });
+    for (std::size_t m = 0; m < count; ++m) {
+      if (!report_collided_[m]) continue;
+      for (std::uint32_t k = report_offsets_[m]; k < report_offsets_[m + 1]; ++k) {
+        if (contacts_[k].type == ContactType::kColliding) collision_log_.push_back(contacts_[k]);
+      }
     }
   }
   if (collision_log_.size() > 2 * kMaxCollisionLogSize) {
