@@ -15,8 +15,11 @@ struct CollideStats {
   // The cached witness still separated the shapes by more than the contact
   // distance, so the full test was skipped.
   bool witness_early_out = false;
-  // The full test ran and kept the cached feature as the defining feature.
+  // The cached feature was kept as the defining feature.
   bool witness_kept = false;
+  // ...without running the full test: the last test's separation bounds it
+  // (SeparatingWitness::sat_separation).
+  bool test_skipped = false;
   // m; with no contact points, the gap along an axis that separates the
   // shapes: a lower bound on their distance (-infinity when not known).
   double gap = -std::numeric_limits<double>::infinity();

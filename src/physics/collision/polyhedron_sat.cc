@@ -3,10 +3,13 @@
 // (Gregorius, "The Separating Axis Test between Convex Polyhedra", GDC 2013).
 #include "physics/collision/polyhedron_sat.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "physics/collision/polyhedron_manifold.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -203,9 +206,12 @@ PairInA MakePairInA(const PolyhedronPair& pair) {
   const Mat3 rotation = frame.a_from_b.rotation.toRotationMatrix();
   frame.b_from_a_matrix = rotation.transpose();
   b_vertices.resize(pair.b->vertices.size());
+  double b_reach_squared = 0.0;
   for (std::size_t i = 0; i < b_vertices.size(); ++i) {
     b_vertices[i] = Multiply(rotation, pair.b->vertices[i]) + frame.a_from_b.translation;
+    b_reach_squared = std::max(b_reach_squared, pair.b->vertices[i].squaredNorm());
   }
+  frame.b_reach = std::sqrt(b_reach_squared);
   b_normals.resize(pair.b->faces.size());
   for (std::size_t i = 0; i < b_normals.size(); ++i) {
     b_normals[i] = Multiply(rotation, pair.b->faces[i].normal);
@@ -213,6 +219,15 @@ PairInA MakePairInA(const PolyhedronPair& pair) {
   frame.b_vertices = &b_vertices;
   frame.b_normals = &b_normals;
   return frame;
+}
+
+double EdgePairDistance(const PairInA& frame, int edge_a, int edge_b) {
+  const EdgeInA a = EdgeOfA(frame, edge_a);
+  const EdgeInA b = EdgeOfB(frame, edge_b);
+  Vec3 on_a;
+  Vec3 on_b;
+  ClosestPointsOfSegments(a.start, a.direction, b.start, b.direction, &on_a, &on_b);
+  return (on_a - on_b).norm();
 }
 
 // Separation along a cached edge-pair witness (Baraff's coherence: the

@@ -17,6 +17,7 @@ struct PairInA {
   Pose world_from_a;
   Pose a_from_b;
   Mat3 b_from_a_matrix;                     // rotation, for the per-face queries
+  double b_reach = 0.0;                     // m, the largest |vertex| of B in B's frame
   std::vector<Vec3>* b_vertices = nullptr;  // m, frame A
   std::vector<Vec3>* b_normals = nullptr;   // unit, frame A
 };
@@ -34,6 +35,10 @@ double FaceWitnessSeparation(const PolyhedronPair& pair, const SeparatingWitness
 // -infinity for a witness that does not fit the pair.
 double EdgeWitnessSeparation(const PairInA& frame, const SeparatingWitness& witness,
                              Vec3* normal_world, bool* still_minkowski_face);
+
+// The distance between edge `edge_a` of A and edge `edge_b` of B, as
+// segments.
+double EdgePairDistance(const PairInA& frame, int edge_a, int edge_b);
 
 // Every candidate axis, stopping once one separates by more than `early_out`.
 SatResult RunSat(const PairInA& frame, double early_out);

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/types.h"
@@ -58,9 +59,19 @@ struct ContactManifold {
 // tested first on the next step.
 struct SeparatingWitness {
   enum class Type : std::uint8_t { kNone, kFaceA, kFaceB, kEdges };
+  SeparatingWitness() = default;
+  SeparatingWitness(Type feature, int a, int b) : type(feature), index_a(a), index_b(b) {}
+
   Type type = Type::kNone;
   int index_a = -1;  // face of A, or edge of A
   int index_b = -1;  // face of B, or edge of B
+  // When the full separating-axis test between two polyhedra last ran: an
+  // upper bound on their signed distance then (m, +infinity when none is
+  // known), and B's pose in A's frame. While B has moved little in A's frame
+  // since, the test's answer is bounded without running it
+  // (CollidePolyhedra).
+  double distance_bound = std::numeric_limits<double>::infinity();
+  Pose a_from_b_at_test;
 };
 
 }  // namespace rigid_body_sim::physics
