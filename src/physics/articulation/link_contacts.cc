@@ -122,7 +122,7 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
     normal_row.target = 0.0;
   }
   const double depth = -separation - solver.penetration_slop;
-  normal_row.impulse = pair.warm_start[i].normal_impulse;
+  normal_row.impulse = pair.WarmStart(i).normal_impulse;
   const int normal_index = solver_.AddRow(std::move(normal_row));
   if (depth > 0.0) {
     link_penetrations_.emplace_back(normal_index, solver.position_correction * depth / step.dt);
@@ -134,7 +134,7 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
     tangent_row.b = std::move(sides_b[1 + t]);
     tangent_row.normal_row = normal_index;
     tangent_row.friction = friction;
-    tangent_row.impulse = pair.warm_start[i].tangent_impulse[t];
+    tangent_row.impulse = pair.WarmStart(i).tangent_impulse[t];
     solver_.AddRow(std::move(tangent_row));
   }
   return normal_index;

@@ -39,19 +39,17 @@ void SortByPairKey(std::vector<KeyedPair>* keyed, std::vector<KeyedPair>* scratc
 // with the same features, else of the nearest unmatched one; a pair with no
 // point this step keeps none for the next.
 void MatchWarmStarts(ShapePairContact* entry) {
+  entry->warm_from = {-1, -1, -1, -1};
   if (entry->manifold.point_count == 0) {
     entry->previous_count = 0;
     return;
   }
   std::array<bool, ContactManifold::kMaxPoints> taken{};  // previous points matched
-  std::array<bool, ContactManifold::kMaxPoints> found{};  // this step's points matched
   for (int i = 0; i < entry->manifold.point_count; ++i) {
-    CachedImpulse& warm = entry->warm_start[i];
-    warm = CachedImpulse{entry->manifold.points[i].feature, 0.0, {0.0, 0.0}};
     for (int k = 0; k < entry->previous_count; ++k) {
-      if (entry->previous[k].feature == warm.feature) {
-        warm = entry->previous[k];
-        taken[k] = found[i] = true;
+      if (entry->previous[k].feature == entry->manifold.points[i].feature) {
+        entry->warm_from[i] = static_cast<std::int8_t>(k);
+        taken[k] = true;
         break;
       }
     }
@@ -61,7 +59,7 @@ void MatchWarmStarts(ShapePairContact* entry) {
   // the impulses of the nearest unmatched point of last step within
   // kPositionMatchDistance, as a persistent manifold matches by distance.
   for (int i = 0; i < entry->manifold.point_count; ++i) {
-    if (found[i]) continue;
+    if (entry->warm_from[i] >= 0) continue;
     const Vec3& position = entry->manifold.points[i].position_world;
     int nearest = -1;
     double nearest_squared = kPositionMatchDistance * kPositionMatchDistance;
@@ -74,11 +72,7 @@ void MatchWarmStarts(ShapePairContact* entry) {
     }
     if (nearest < 0) continue;
     taken[nearest] = true;
-    CachedImpulse& warm = entry->warm_start[i];
-    warm.normal_impulse = entry->previous[nearest].normal_impulse;
-    warm.tangent_impulse = entry->previous[nearest].tangent_impulse;
-    warm.preload = entry->previous[nearest].preload;
-    warm.approach_velocity = entry->previous[nearest].approach_velocity;
+    entry->warm_from[i] = static_cast<std::int8_t>(nearest);
   }
 }
 

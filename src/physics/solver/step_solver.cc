@@ -194,10 +194,11 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
       point.r_b = contact.position_world - b.position;
       point.separation = contact.separation;
       point.feature = contact.feature;
-      point.normal_impulse = pair->warm_start[i].normal_impulse;
-      point.tangent_impulse = pair->warm_start[i].tangent_impulse;
-      point.preload = pair->warm_start[i].preload;
-      point.carried_approach = pair->warm_start[i].approach_velocity;
+      const CachedImpulse& warm = pair->WarmStart(i);
+      point.normal_impulse = warm.normal_impulse;
+      point.tangent_impulse = warm.tangent_impulse;
+      point.preload = warm.preload;
+      point.carried_approach = warm.approach_velocity;
     }
   });
 }
