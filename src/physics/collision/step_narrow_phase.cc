@@ -126,7 +126,7 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
   // tests which pair, and the order of the entries is the walk's.
   step.pool->ParallelFor(narrow_jobs_.size(), kJobsPerChunk, [this](std::size_t j) {
     if (j + kEntryPrefetchDistance < narrow_jobs_.size()) {
-      PrefetchManifold(*narrow_jobs_[j + kEntryPrefetchDistance].entry);
+      PrefetchCollide(*narrow_jobs_[j + kEntryPrefetchDistance].entry);
     }
     CollideShapePair(&narrow_jobs_[j]);
   });

@@ -120,6 +120,13 @@ inline void PrefetchManifold(const ShapePairContact& entry) {
   PrefetchBytes(&entry, offsetof(ShapePairContact, manifold) + sizeof(entry.manifold));
 }
 
+// Starts loading what a narrow-phase test of an entry reads and writes: the
+// visit fields, the witness and the manifold, the anchors a carried
+// manifold moves with, and last step's points its warm starts match.
+inline void PrefetchCollide(const ShapePairContact& entry) {
+  PrefetchBytes(&entry, offsetof(ShapePairContact, previous) + sizeof(entry.previous));
+}
+
 // Starts loading what the stages after the narrow phase read and write of
 // an entry: the manifold, the warm start and last step's points.
 inline void PrefetchPoints(const ShapePairContact& entry) {
