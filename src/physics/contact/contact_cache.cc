@@ -10,8 +10,11 @@ namespace {
 // when their features differ. Resting points move far less in a step.
 constexpr double kPositionMatchDistance = 1e-3;
 
-// A key's body A: its top 20 bits (ContactCache::Key).
+// A key's body A: its top 20 bits (ContactCache::Key); body B the 20 below
+// them.
 constexpr int kBodyAShift = 44;
+constexpr int kBodyBShift = 24;
+constexpr std::uint32_t kBodyMask = (1u << 20) - 1;
 
 }  // namespace
 
@@ -81,7 +84,7 @@ void MatchWarmStarts(ShapePairContact* entry) {
 std::uint64_t ContactCache::Key(std::uint32_t body_a, std::uint16_t shape_a, std::uint32_t body_b,
                                 std::uint16_t shape_b) {
   assert(body_a < (1u << 20) && body_b < (1u << 20) && shape_a < 4096 && shape_b < 4096);
-  return (std::uint64_t{body_a} << kBodyAShift) | (std::uint64_t{body_b} << 24) |
+  return (std::uint64_t{body_a} << kBodyAShift) | (std::uint64_t{body_b} << kBodyBShift) |
          (std::uint64_t{shape_a} << 12) | std::uint64_t{shape_b};
 }
 
@@ -180,7 +183,12 @@ void ContactCache::ListTouching(TaskPool* pool) {
   // whatever order the pairs were visited in. The keys sit next to the
   // pointers, so the sort does not chase them.
   SortByPairKey(&keyed_, &sorted_, &body_starts_);
-  for (const auto& [key, entry] : keyed_) touching_.push_back(entry);
+  touching_bodies_.clear();
+  for (const auto& [key, entry] : keyed_) {
+    touching_.push_back(entry);
+    touching_bodies_.push_back({static_cast<std::uint32_t>(key >> kBodyAShift),
+                                static_cast<std::uint32_t>(key >> kBodyBShift) & kBodyMask});
+  }
   if (frozen_changed_) ListSleeping();
 }
 

@@ -134,6 +134,11 @@ inline void PrefetchPoints(const ShapePairContact& entry) {
   PrefetchBytes(&entry.warm_from, sizeof(entry.warm_from) + sizeof(entry.previous));
 }
 
+// Starts loading the friction anchor of an entry.
+inline void PrefetchFrictionAnchor(const ShapePairContact& entry) {
+  PrefetchBytes(&entry.friction_anchor, sizeof(entry.friction_anchor));
+}
+
 // For a walk over `entries` now at `index`: `prefetch` (PrefetchManifold or
 // PrefetchPoints) of the entry kEntryPrefetchDistance ahead, if there is one.
 inline void PrefetchAhead(const std::vector<ShapePairContact*>& entries, std::size_t index,
@@ -185,6 +190,11 @@ class ContactCache {
   void ListTouching(TaskPool* pool);
   // Pairs with at least one contact point this step, in key order.
   const std::vector<ShapePairContact*>& touching() const { return touching_; }
+  // The bodies (A, B) of each pair of touching(), read from their keys: a
+  // walk over them loads no entry.
+  const std::vector<std::array<std::uint32_t, 2>>& touching_bodies() const {
+    return touching_bodies_;
+  }
   // Every pair the narrow phase looked at this step, touching or not, in
   // the order it looked at them.
   const std::vector<ShapePairContact*>& seen() const { return seen_; }
@@ -209,6 +219,7 @@ class ContactCache {
   PairIndex<ShapePairContact> index_;  // key -> entry of pairs_, for Touch
   PairMap frozen_;                     // pairs of two sleeping (or static) bodies
   std::vector<ShapePairContact*> touching_;
+  std::vector<std::array<std::uint32_t, 2>> touching_bodies_;
   std::vector<ShapePairContact*> seen_;     // after Prune, every entry of pairs_
   std::vector<ShapePairContact*> visited_;  // Touch's first visits of the step, in order
   // ListTouching's scratch: each seen entry's key, and the entry if it

@@ -23,9 +23,10 @@ void WorldImpl::UpdateContactCache() {
   auto sleeps = [](const Body& body) { return !body.is_static && !body.awake; };
   has_sleeper_.resize(touching.size());
   constexpr std::size_t kPairsPerChunk = 256;
+  const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = contact_cache_.touching_bodies();
   pool_->ParallelFor(touching.size(), kPairsPerChunk, [&](std::size_t m) {
     has_sleeper_[m] =
-        sleeps(bodies_[touching[m]->body_a]) || sleeps(bodies_[touching[m]->body_b]) ? 1 : 0;
+        sleeps(bodies_[pair_bodies[m][0]]) || sleeps(bodies_[pair_bodies[m][1]]) ? 1 : 0;
   });
   for (std::size_t m = 0; m < touching.size(); ++m) {
     if (has_sleeper_[m] == 0) continue;

@@ -110,15 +110,15 @@ void WorldImpl::UpdateSleep(const StepContext& step) {
   // The touching pairs' bodies are read out of their cache entries on the
   // pool (each entry, and each body, a load the caches no longer hold), and
   // joined here from the list.
-  const std::vector<ShapePairContact*>& touching = contact_cache_.touching();
+  const std::vector<std::array<std::uint32_t, 2>>& touching = contact_cache_.touching_bodies();
   std::vector<std::array<std::uint32_t, 2>>& edges = sleep_scratch_.edges;
   edges.resize(touching.size());
   constexpr std::size_t kPairsPerChunk = 256;
   step.pool->ParallelFor(touching.size(), kPairsPerChunk, [&](std::size_t m) {
-    const ShapePairContact& pair = *touching[m];
-    const bool joins = !bodies_[pair.body_a].is_static && !bodies_[pair.body_b].is_static;
-    edges[m] = joins ? std::array<std::uint32_t, 2>{pair.body_a, pair.body_b}
-                     : std::array<std::uint32_t, 2>{pair.body_a, pair.body_a};
+    const std::uint32_t a = touching[m][0];
+    const std::uint32_t b = touching[m][1];
+    const bool joins = !bodies_[a].is_static && !bodies_[b].is_static;
+    edges[m] = joins ? std::array<std::uint32_t, 2>{a, b} : std::array<std::uint32_t, 2>{a, a};
   });
   for (const std::array<std::uint32_t, 2>& edge : edges) {
     if (edge[0] != edge[1]) islands.Join(edge[0], edge[1]);

@@ -62,11 +62,15 @@ void SoftStepSolver::Solve(const StepContext& step) {
   // The anchors to and from the pairs' cache entries on the pool: each
   // entry is a load from memory the caches no longer hold.
   anchors_.resize(w.rigid_pairs_.size());
-  step.pool->ParallelFor(w.rigid_pairs_.size(), kPairsPerChunk,
-                         [&](std::size_t m) { anchors_[m] = w.rigid_pairs_[m]->friction_anchor; });
+  step.pool->ParallelFor(w.rigid_pairs_.size(), kPairsPerChunk, [&](std::size_t m) {
+    PrefetchAhead(w.rigid_pairs_, m, PrefetchFrictionAnchor);
+    anchors_[m] = w.rigid_pairs_[m]->friction_anchor;
+  });
   solver_.Step(input, step.pool, &bodies_, &w.solver_.manifolds(), &anchors_);
-  step.pool->ParallelFor(w.rigid_pairs_.size(), kPairsPerChunk,
-                         [&](std::size_t m) { w.rigid_pairs_[m]->friction_anchor = anchors_[m]; });
+  step.pool->ParallelFor(w.rigid_pairs_.size(), kPairsPerChunk, [&](std::size_t m) {
+    PrefetchAhead(w.rigid_pairs_, m, PrefetchFrictionAnchor);
+    w.rigid_pairs_[m]->friction_anchor = anchors_[m];
+  });
   StoreVelocities(step);
   w.DisableNonFiniteBodies();
   w.articulations_.Solve(step);
