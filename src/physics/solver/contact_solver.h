@@ -136,6 +136,10 @@ class ContactSolver {
   std::vector<SolverBody>& bodies() { return bodies_; }
   std::vector<SolverManifold>& manifolds() { return manifolds_; }
   const std::vector<SolverManifold>& manifolds() const { return manifolds_; }
+  // Each manifold's (body_a, body_b), beside them: a walk over the bodies
+  // loads 8 bytes a manifold instead of its line (WorldImpl::
+  // BuildSolverManifolds writes both).
+  std::vector<std::array<std::uint32_t, 2>>& manifold_bodies() { return manifold_bodies_; }
 
   // Computes the tangent basis of every manifold (r_a and r_b are set by
   // the caller), and classifies each point by v_r before anything acts.
@@ -230,6 +234,7 @@ class ContactSolver {
   bool velocities_changed_ = false;
   std::vector<SolverBody> bodies_;
   std::vector<SolverManifold> manifolds_;
+  std::vector<std::array<std::uint32_t, 2>> manifold_bodies_;
   std::vector<RestingRow> rows_;
   // The bodies of the current collision round's points, each once.
   std::vector<std::uint32_t> collision_bodies_;

@@ -1,6 +1,7 @@
 #include "physics/solver/soft_contact_solver.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "physics/contact/contact_frame.h"
@@ -133,16 +134,19 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     load(i);
     (*bodies)[i].delta_rotation = Quat::Identity();
   }
-  for (const SolverManifold& manifold : *manifolds) {
-    if (!moving_mask_[manifold.body_a]) load(manifold.body_a);
-    if (!moving_mask_[manifold.body_b]) load(manifold.body_b);
-  }
+  // The manifolds' bodies from the dense list beside them: a manifold is
+  // hundreds of bytes, and walking them here would load each one's line.
+  const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *input.manifold_bodies;
+  assert(pair_bodies.size() == manifolds->size());
   anchors->resize(manifolds->size());
   body_a_.resize(manifolds->size());
   body_b_.resize(manifolds->size());
-  for (std::size_t m = 0; m < manifolds->size(); ++m) {
-    body_a_[m] = (*manifolds)[m].body_a;
-    body_b_[m] = (*manifolds)[m].body_b;
+  for (std::size_t m = 0; m < pair_bodies.size(); ++m) {
+    const auto [a, b] = pair_bodies[m];
+    if (!moving_mask_[a]) load(a);
+    if (!moving_mask_[b]) load(b);
+    body_a_[m] = a;
+    body_b_[m] = b;
   }
   ColourConstraints(body_a_, body_b_, moving_mask_, &colour_masks_, &colour_of_, &colouring_);
   // The constraints are stored in the colouring's order, so that each pass

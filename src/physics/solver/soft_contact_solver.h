@@ -69,6 +69,8 @@ struct SoftStepInput {
   // set); with the manifolds' bodies, the only ones it reads, so bodies
   // asleep and out of contact cost nothing.
   const std::vector<std::uint32_t>* moving = nullptr;
+  // Each manifold's (body_a, body_b), in the manifolds' order.
+  const std::vector<std::array<std::uint32_t, 2>>* manifold_bodies = nullptr;
 };
 
 class SoftContactSolver {

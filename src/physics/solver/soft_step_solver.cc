@@ -57,6 +57,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   // flat stops on its first corners' speculative rows, the others a fraction
   // of a millimetre up.
   input.moving = &w.moving_bodies_;
+  input.manifold_bodies = &w.solver_.manifold_bodies();
   input.touch_tolerance =
       std::max(w.settings_.solver.contact_tolerance, 0.1 * w.settings_.contact_margin);
   // The anchors to and from the pairs' cache entries on the pool: each
@@ -105,8 +106,8 @@ void SoftStepSolver::LoadBodies(const StepContext& step) {
   WorldImpl& w = world_;
   bodies_.resize(w.bodies_.size());
   // The moving bodies are loaded on the pool below.
-  for (const SolverManifold& manifold : w.solver_.manifolds()) {
-    for (const std::uint32_t i : {manifold.body_a, manifold.body_b}) {
+  for (const std::array<std::uint32_t, 2>& pair : w.solver_.manifold_bodies()) {
+    for (const std::uint32_t i : pair) {
       if (WorldImpl::MovesThisStep(w.bodies_[i])) continue;
       bodies_[i] = SoftBody();
       bodies_[i].position = w.bodies_[i].position;

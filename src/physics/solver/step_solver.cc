@@ -167,9 +167,12 @@ void WorldImpl::BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs
   // Resized, not cleared (ContactSolver::Reset keeps them): a manifold with
   // its four points is 648 bytes, and each is built afresh below, on the pool.
   manifolds.resize(pairs.size());
+  std::vector<std::array<std::uint32_t, 2>>& manifold_bodies = solver_.manifold_bodies();
+  manifold_bodies.resize(pairs.size());
   step.pool->ParallelFor(pairs.size(), kManifoldsPerChunk, [&](std::size_t m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
     const ShapePairContact* pair = pairs[m];
+    manifold_bodies[m] = {pair->body_a, pair->body_b};
     const Body& a = bodies_[pair->body_a];
     const Body& b = bodies_[pair->body_b];
     // Reset field by field: assigning a fresh SolverManifold built all four
