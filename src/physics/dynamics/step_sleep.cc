@@ -107,9 +107,9 @@ void WorldImpl::UpdateSleep(const StepContext& step) {
   // The islands' scratch keeps its memory from step to step.
   UnionFind& islands = sleep_scratch_.islands;
   islands.Reset(bodies_.size());
-  // The touching pairs' bodies are read out of their cache entries on the
-  // pool (each entry, and each body, a load the caches no longer hold), and
-  // joined here from the list.
+  // The touching pairs' bodies come from their keys (no entry is loaded);
+  // whether each joins an island is read on the pool (each body a load the
+  // caches no longer hold), and the joins are made here from the list.
   const std::vector<std::array<std::uint32_t, 2>>& touching = contact_cache_.touching_bodies();
   std::vector<std::array<std::uint32_t, 2>>& edges = sleep_scratch_.edges;
   edges.resize(touching.size());
