@@ -17,8 +17,8 @@ struct CollideStats {
   bool witness_early_out = false;
   // The cached feature was kept as the defining feature.
   bool witness_kept = false;
-  // ...without running the full test: the last test's separation bounds it
-  // (SeparatingWitness::sat_separation).
+  // ...without running the full test: the bound kept when it last ran
+  // proves it would keep the feature (SeparatingWitness::distance_bound).
   bool test_skipped = false;
   // m; with no contact points, the gap along an axis that separates the
   // shapes: a lower bound on their distance (-infinity when not known).
