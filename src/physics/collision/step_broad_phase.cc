@@ -1,10 +1,11 @@
-// Stage 1 of WorldImpl::Step: every body's swept, fattened box goes to the
+// Stage 1 of World::Step (CollisionSystem): every body's swept, fattened box goes to the
 // sort-and-sweep broad phase, which returns the candidate pairs.
+#include <algorithm>
 #include <variant>
 
+#include "physics/collision/collision_system.h"
 #include "physics/dynamics/body_frames.h"
 #include "physics/geometry/shape_bounds.h"
-#include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
 namespace {
@@ -70,11 +71,37 @@ bool Holds(const Aabb& outer, const Aabb& inner) {
 
 }  // namespace
 
+CollisionSystem::CollisionSystem(const CollisionWorld& world)
+    : bodies_(*world.bodies),
+      contact_cache_(*world.contact_cache),
+      settings_(*world.settings),
+      articulations_(*world.articulations) {}
+
+void CollisionSystem::AddBody(std::uint32_t index) {
+  const Body& body = bodies_[index];
+  if (body.shapes.size() == 1 && std::holds_alternative<HalfSpace>(body.shapes[0].geometry)) {
+    half_space_bodies_.push_back(index);
+  }
+}
+
+void CollisionSystem::RemoveProxy(std::uint32_t index) {
+  Body& body = bodies_[index];
+  if (!body.has_proxy) return;
+  broad_phase_.RemoveProxy(static_cast<int>(index));
+  body.has_proxy = false;
+}
+
+void CollisionSystem::ForgetBody(std::uint32_t index) {
+  RemoveProxy(index);
+  half_space_bodies_.erase(std::remove(half_space_bodies_.begin(), half_space_bodies_.end(), index),
+                           half_space_bodies_.end());
+}
+
 // The bodies that need a box this step are listed in slot order; their
 // boxes are made on the pool (a box reads its own body and writes only that
 // body's support hints), then handed to the broad phase in the same order,
 // so the proxies and their pairs do not depend on the thread count.
-void WorldImpl::UpdateBroadPhase(const StepContext& step) {
+void CollisionSystem::UpdateBroadPhase(const StepContext& step) {
   proxy_bodies_.clear();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Body& body = bodies_[i];

@@ -1,14 +1,14 @@
-// Stage 2 of WorldImpl::Step: a contact manifold for every pair of shapes of the
+// Stage 2 of World::Step (CollisionSystem): a contact manifold for every pair of shapes of the
 // candidate body pairs, each starting from its cached separating witness.
 #include <algorithm>
 #include <limits>
 #include <variant>
 
+#include "physics/collision/collision_system.h"
 #include "physics/collision/mesh_collision.h"
 #include "physics/collision/narrow_phase.h"
 #include "physics/dynamics/body_frames.h"
 #include "physics/geometry/shape_bounds.h"
-#include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
 
@@ -93,9 +93,8 @@ void CollideMeshSlots(const MeshVisit& visit, const ConvexMeshPair& pair) {
 
 }  // namespace
 
-void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
+void CollisionSystem::UpdateNarrowPhase(const StepContext& step) {
   ++step_count_;
-  last_step_profile_.reused_manifolds = 0;
   const std::vector<ProxyPair>& pairs = broad_phase_.Pairs();
   // The body pair in CollideBodies' order, for its first shapes' cache entry.
   auto prefetch = [&](ContactCache::Prefetch stage, std::size_t k) {
@@ -130,13 +129,14 @@ void WorldImpl::UpdateNarrowPhase(const StepContext& step) {
     }
     CollideShapePair(&narrow_jobs_[j]);
   });
-  for (const NarrowJob& job : narrow_jobs_) last_step_profile_.reused_manifolds += job.reused;
+  reused_manifolds_ = 0;
+  for (const NarrowJob& job : narrow_jobs_) reused_manifolds_ += job.reused;
 }
 
 // The pairs of the half-space `plane` with the awake bodies near it, walked
 // as the broad phase's are: each body tested and each pair visited on the
 // pool, then listed here in the bodies' order.
-void WorldImpl::VisitPlane(std::uint32_t plane, const StepContext& step) {
+void CollisionSystem::VisitPlane(std::uint32_t plane, const StepContext& step) {
   const Pose world_from_plane =
       bodies_[plane].WorldFromBody() * bodies_[plane].shapes.front().body_from_shape;
   const Vec3 normal = world_from_plane.rotation * Vec3::UnitZ();
@@ -165,12 +165,13 @@ void WorldImpl::VisitPlane(std::uint32_t plane, const StepContext& step) {
 }
 
 // m; the margin plus the distance the two bodies can close in one step.
-double WorldImpl::ContactDistance(const Body& a, const Body& b, const StepContext& step) const {
+double CollisionSystem::ContactDistance(const Body& a, const Body& b,
+                                        const StepContext& step) const {
   return ContactMargin(a, b) + ContactReach(a, b, step);
 }
 
 // m; the pair's contact margin: at most a fraction of its thinner body.
-double WorldImpl::ContactMargin(const Body& a, const Body& b) const {
+double CollisionSystem::ContactMargin(const Body& a, const Body& b) const {
   return std::min(settings_.contact_margin,
                   kMarginPerThickness * std::min(a.thickness, b.thickness));
 }
@@ -178,7 +179,7 @@ double WorldImpl::ContactMargin(const Body& a, const Body& b) const {
 // m; a bound on how far two points of the bodies can close in one step:
 // their relative speed, each body's turn times its bounding radius, and
 // gravity's half g dt^2.
-double WorldImpl::ContactReach(const Body& a, const Body& b, const StepContext& step) const {
+double CollisionSystem::ContactReach(const Body& a, const Body& b, const StepContext& step) const {
   const double closing_speed = (a.linear_velocity - b.linear_velocity).norm() +
                                a.angular_velocity.norm() * a.bounding_radius +
                                b.angular_velocity.norm() * b.bounding_radius;
@@ -194,8 +195,9 @@ double WorldImpl::ContactReach(const Body& a, const Body& b, const StepContext& 
 // the vertex to the face's plane, so resting contact sees exact gaps; only
 // where clipping would put the points is off, by at most the motion bound
 // |dt| + angle r_a (reuse_error).
-bool WorldImpl::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
-                              const Pose& world_from_shape_b, ShapePairContact* entry) const {
+bool CollisionSystem::ReuseManifold(const Pose& b_from_a, double reach_a,
+                                    const Pose& world_from_shape_a, const Pose& world_from_shape_b,
+                                    ShapePairContact* entry) const {
   const ManifoldAnchors& anchors = entry->anchors;
   if (!anchors.valid || settings_.contact_reuse_distance <= 0.0) return false;
   const double motion = (b_from_a.translation - anchors.b_from_a.translation).norm() +
@@ -220,8 +222,9 @@ bool WorldImpl::ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& 
 // Records the anchors of a manifold just clipped between two polyhedra with
 // a face witness; edge/edge manifolds, spheres and half-spaces are made
 // afresh every step.
-void WorldImpl::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
-                               const Pose& world_from_shape_b, ShapePairContact* entry) const {
+void CollisionSystem::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
+                                     const Pose& world_from_shape_b,
+                                     ShapePairContact* entry) const {
   ManifoldAnchors& anchors = entry->anchors;
   const ContactManifold& manifold = entry->manifold;
   const SeparatingWitness::Type type = entry->witness.type;
@@ -251,7 +254,8 @@ void WorldImpl::AnchorManifold(const Pose& b_from_a, const Pose& world_from_shap
 // have travelled less than g minus the contact distance since: no point of
 // either has moved far enough to bring them within it (conservative
 // advancement's bound, kept across steps).
-void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const StepContext& step) {
+void CollisionSystem::CollideBodies(std::uint32_t body_a, std::uint32_t body_b,
+                                    const StepContext& step) {
   MovingBodyFirst(bodies_, &body_a, &body_b);
   const Body& a = bodies_[body_a];
   const Body& b = bodies_[body_b];
@@ -305,7 +309,7 @@ void WorldImpl::CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const 
 
 // CollideBodies' work on a pair of single convex shapes whose entry exists:
 // it reads the bodies and writes only that entry.
-void WorldImpl::VisitPair(ProxyPair pair, const StepContext& step, PairVisit* visit) {
+void CollisionSystem::VisitPair(ProxyPair pair, const StepContext& step, PairVisit* visit) {
   *visit = PairVisit();
   auto body_a = static_cast<std::uint32_t>(pair.first);
   auto body_b = static_cast<std::uint32_t>(pair.second);
@@ -333,7 +337,7 @@ void WorldImpl::VisitPair(ProxyPair pair, const StepContext& step, PairVisit* vi
 }
 
 // What the walk on one thread does with a visited pair, in the pairs' order.
-void WorldImpl::ListPair(ProxyPair pair, const PairVisit& visit, const StepContext& step) {
+void CollisionSystem::ListPair(ProxyPair pair, const PairVisit& visit, const StepContext& step) {
   switch (visit.kind) {
     case PairVisit::Kind::kSkipped:
       return;
@@ -357,7 +361,7 @@ void WorldImpl::ListPair(ProxyPair pair, const PairVisit& visit, const StepConte
 
 // The poses are made from the bodies as CollideBodies would make them, so a
 // pair's test gives the same manifold wherever it runs.
-void WorldImpl::CollideShapePair(NarrowJob* job) const {
+void CollisionSystem::CollideShapePair(NarrowJob* job) const {
   ShapePairContact& entry = *job->entry;
   const Body& a = bodies_[entry.body_a];
   const Body& b = bodies_[entry.body_b];
@@ -387,7 +391,7 @@ void WorldImpl::CollideShapePair(NarrowJob* job) const {
 }
 
 // The pair's manifold clipped afresh at the current poses.
-void WorldImpl::RecollidePair(const StepContext& step, ShapePairContact* pair) {
+void CollisionSystem::RecollidePair(const StepContext& step, ShapePairContact* pair) {
   const Body& a = bodies_[pair->body_a];
   const Body& b = bodies_[pair->body_b];
   const ShapeDef& shape_a = a.shapes[pair->shape_a];

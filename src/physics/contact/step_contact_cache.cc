@@ -6,11 +6,13 @@
 namespace rigid_body_sim::physics {
 
 void WorldImpl::UpdateContactCache() {
-  contact_cache_.Prune(step_count_, woke_since_prune_, [this](const ShapePairContact& pair) {
+  // A pair whose bodies are each static or asleep is frozen while unseen.
+  auto asleep = [this](const ShapePairContact& pair) {
     const Body& a = bodies_[pair.body_a];
     const Body& b = bodies_[pair.body_b];
     return (a.is_static || (!a.awake && !a.disabled)) && (b.is_static || (!b.awake && !b.disabled));
-  });
+  };
+  contact_cache_.Prune(collision_.step_count(), woke_since_prune_, asleep);
   woke_since_prune_ = false;
   // The narrow phase has matched each seen pair's points with last step's.
   contact_cache_.ListTouching(pool_.get());

@@ -33,10 +33,7 @@ void WorldImpl::DisableBody(std::uint32_t index) {
   body.disabled = true;
   body.awake = false;
   woke_since_prune_ = true;
-  if (body.has_proxy) {
-    broad_phase_.RemoveProxy(static_cast<int>(index));
-    body.has_proxy = false;
-  }
+  collision_.RemoveProxy(index);
   const BodyId id{index, body.generation};
   if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
       non_finite_bodies_.end()) {

@@ -131,7 +131,7 @@ void ExactSolver::SubStep(const std::vector<std::uint32_t>& island, const StepCo
   }
   std::vector<ShapePairContact*> touching;
   for (ShapePairContact* pair : pairs) {
-    world_.RecollidePair(step, pair);
+    world_.collision_.RecollidePair(step, pair);
     if (pair->manifold.point_count == 0) continue;
     if (world_.bodies_[pair->body_a].articulation >= 0 ||
         world_.bodies_[pair->body_b].articulation >= 0)

@@ -142,10 +142,7 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
   id.generation = bodies_[id.index].generation;
   ++body_count_;
   RestartSleepWindow(id.index);
-  const Body& created = bodies_[id.index];
-  if (created.shapes.size() == 1 && std::holds_alternative<HalfSpace>(created.shapes[0].geometry)) {
-    half_space_bodies_.push_back(id.index);
-  }
+  collision_.AddBody(id.index);
   return id;
 }
 
@@ -164,11 +161,8 @@ Status WorldImpl::DestroyBody(BodyId id) {
   if (body.articulation >= 0) {
     return Status::Error("the body is a link of an articulation; destroy the articulation");
   }
-  if (body.has_proxy) broad_phase_.RemoveProxy(static_cast<int>(id.index));
+  collision_.ForgetBody(id.index);
   contact_cache_.RemoveBody(id.index);
-  half_space_bodies_.erase(
-      std::remove(half_space_bodies_.begin(), half_space_bodies_.end(), id.index),
-      half_space_bodies_.end());
   WakeTouching(id.index);
   const std::uint32_t next_generation = body.generation + 1;
   body = Body();
@@ -222,10 +216,7 @@ Status WorldImpl::SetState(BodyId id, const Pose& world_from_body, const Vec3& l
   // whatever rested on the body must notice that it left.
   WakeTouching(id.index);
   contact_cache_.RemoveBody(id.index);
-  if (body.is_static && body.has_proxy) {
-    broad_phase_.RemoveProxy(static_cast<int>(id.index));
-    body.has_proxy = false;
-  }
+  if (body.is_static) collision_.RemoveProxy(id.index);
   return Status::Ok();
 }
 
@@ -322,9 +313,10 @@ void WorldImpl::Step() {
   StepProfile& profile = last_step_profile_;
 
   GuardBeforeStep(step);
-  UpdateBroadPhase(step);
+  collision_.UpdateBroadPhase(step);
   profile.broad_phase_ms = lap();
-  UpdateNarrowPhase(step);
+  collision_.UpdateNarrowPhase(step);
+  profile.reused_manifolds = collision_.reused_manifolds();
   profile.narrow_phase_ms = lap();
   UpdateContactCache();
   profile.contact_cache_ms = lap();

@@ -1,7 +1,9 @@
 // The implementation behind World (world.h), which forwards every call here,
-// so that the public header shows none of the stages' state. Its methods are
-// defined in world_impl.cc (bodies and state) and in one file per stage of
-// Step (step_*.cc).
+// so that the public header shows none of the stages' state. It orders the
+// stages and owns the bodies; stages 1 and 2 are collision_'s
+// (collision/collision_system.h), the articulations' part is
+// articulations_'s. Its methods are defined in world_impl.cc (bodies and
+// state) and in the files of the stages it runs itself (step_*.cc).
 #ifndef RIGID_BODY_SIM_PHYSICS_WORLD_WORLD_IMPL_H_
 #define RIGID_BODY_SIM_PHYSICS_WORLD_WORLD_IMPL_H_
 
@@ -12,7 +14,7 @@
 #include <vector>
 
 #include "physics/articulation/articulation_system.h"
-#include "physics/collision/broad_phase.h"
+#include "physics/collision/collision_system.h"
 #include "physics/contact/contact_cache.h"
 #include "physics/dynamics/integrator.h"
 #include "physics/dynamics/sleep_window.h"
@@ -31,33 +33,6 @@
 #include "rigid_body_sim/physics/world_settings.h"
 
 namespace rigid_body_sim::physics {
-
-// A shape pair the narrow phase tests this step (stage 2): its cache entry,
-// which holds the bodies, shapes and contact distance, and the summed travel
-// of the two bodies (Body::travel). Jobs write only their own entry, so any
-// thread may run any of them.
-struct NarrowJob {
-  ShapePairContact* entry = nullptr;
-  double travel = 0.0;  // m
-  bool reused = false;  // the manifold was carried, not clipped (out)
-};
-
-// A broad-phase pair as the narrow phase's walk first sees it, on any
-// thread (WorldImpl::VisitPair), and what the walk in the pairs' order then
-// does with it (ListPair). Only a pair of two single-shape bodies, neither a
-// static mesh, whose shape pair has a cache entry is handled on the pool;
-// the rest are listed by CollideBodies in the ordered walk.
-struct PairVisit {
-  enum class Kind : std::uint8_t { kSkipped, kInWalk, kSeen, kNew };
-  Kind kind = Kind::kSkipped;
-  bool first_visit = false;  // kSeen: the entry's first visit of the step
-  bool culled = false;       // kSeen: its gap cannot have closed
-  std::uint32_t body_a = 0;  // kSeen, kNew: the moving body first
-  std::uint32_t body_b = 0;
-  ShapePairContact* entry = nullptr;  // kSeen's
-  double contact_distance = 0.0;      // m, kSeen's and kNew's
-  double travel = 0.0;                // m, Body::travel of both
-};
 
 // The public methods do what World's of the same name are documented to do.
 class WorldImpl final : public LinkBodies {
@@ -137,9 +112,8 @@ class WorldImpl final : public LinkBodies {
   // Wakes every body that touched `body` in the last step.
   void WakeTouching(std::uint32_t body);
 
-  // The stages of Step, in order, one file each (step_*.cc).
-  void UpdateBroadPhase(const StepContext& step);   // 1. broad phase: swept boxes, candidate pairs
-  void UpdateNarrowPhase(const StepContext& step);  // 2. narrow phase: manifolds per shape pair
+  // The stages of Step, in order: 1 and 2 are collision_'s
+  // (collision/collision_system.h), 3 is here (contact/step_contact_cache.cc).
   void UpdateContactCache();  // 3. contact cache: pruned, touching pairs listed
   // 4 and 5, from velocities to poses, are motion_solver_'s (solver/).
   // The awake, enabled bodies that are not links into moving_bodies_.
@@ -155,24 +129,6 @@ class WorldImpl final : public LinkBodies {
   std::size_t ReportSleepingContacts(const StepContext& step);
   void WriteReports(std::size_t m, const std::vector<ShapePairContact*>& pairs, double dt,
                     bool impacts_only);
-  // The pair's manifold clipped afresh at the current poses (step_narrow_phase.cc).
-  void RecollidePair(const StepContext& step, ShapePairContact* pair);
-  // Lists the shape pairs of two bodies that need a test (narrow_jobs_);
-  // a static mesh's are tested at once.
-  void CollideBodies(std::uint32_t body_a, std::uint32_t body_b, const StepContext& step);
-  // CollideBodies in two halves for a pair of single shapes (PairVisit).
-  void VisitPair(ProxyPair pair, const StepContext& step, PairVisit* visit);
-  void ListPair(ProxyPair pair, const PairVisit& visit, const StepContext& step);
-  void VisitPlane(std::uint32_t plane, const StepContext& step);
-  // Tests one listed shape pair: carries its manifold or clips a new one.
-  void CollideShapePair(NarrowJob* job) const;
-  double ContactDistance(const Body& a, const Body& b, const StepContext& step) const;
-  double ContactReach(const Body& a, const Body& b, const StepContext& step) const;
-  double ContactMargin(const Body& a, const Body& b) const;
-  bool ReuseManifold(const Pose& b_from_a, double reach_a, const Pose& world_from_shape_a,
-                     const Pose& world_from_shape_b, ShapePairContact* entry) const;
-  void AnchorManifold(const Pose& b_from_a, const Pose& world_from_shape_a,
-                      const Pose& world_from_shape_b, ShapePairContact* entry) const;
   // Stage 5's end, both solvers' (dynamics/step_sleep.cc).
   void UpdateSleep(const StepContext& step);
   bool UpdateSpeedingUp(const StepContext& step, Body* body) const;
@@ -196,19 +152,10 @@ class WorldImpl final : public LinkBodies {
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
   std::unique_ptr<MotionSolver> motion_solver_;  // settings_.motion_solver
-  std::vector<PairVisit> pair_visits_;    // stage 2's, per broad-phase pair, then per plane pair
-  std::vector<std::uint8_t> near_plane_;  // VisitPlane's, per body slot
-  std::vector<ProxyPair> plane_pairs_;    // VisitPlane's: (body, plane)
-  std::vector<NarrowJob> narrow_jobs_;    // stage 2's, in the order the pairs were visited
-  std::vector<Body> bodies_;              // slots; a destroyed body's slot is reused
+  std::vector<Body> bodies_;                     // slots; a destroyed body's slot is reused
   std::vector<std::uint32_t> free_slots_;
   std::size_t body_count_ = 0;
   double time_ = 0.0;
-  std::uint64_t step_count_ = 0;
-  SortAndSweepBroadPhase broad_phase_;
-  std::vector<std::uint32_t> proxy_bodies_;       // stage 1's: the bodies whose box is made
-  std::vector<Aabb> proxy_boxes_;                 // stage 1's, per proxy_bodies_ entry
-  std::vector<std::uint32_t> half_space_bodies_;  // static bodies whose one shape is a HalfSpace
   ContactCache contact_cache_;
   bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3
   // contacts_ begins with the reports of the sleeping pairs, made when
@@ -251,6 +198,7 @@ class WorldImpl final : public LinkBodies {
   StepProfile last_step_profile_;
   std::vector<ShapePairContact*> rigid_pairs_;  // the touching pairs without a link
   ArticulationSystem articulations_{&bodies_, this};
+  CollisionSystem collision_{{&bodies_, &contact_cache_, &settings_, &articulations_}};
 };
 
 }  // namespace rigid_body_sim::physics
