@@ -88,7 +88,7 @@ void ExactSolver::IntegrateBodies(const StepContext& step) {
   BoundBodyMotion(step);
   ResolveImpacts(step, FindImpacts(step, world_.contact_cache_.seen()),
                  world_.contact_cache_.touching(), 0);
-  world_.UpdateSleep(step);
+  world_.sleep_.Update(step, world_.moving_bodies_);
 }
 
 // Scales a moving body's angular momenta (at the start and the end of the

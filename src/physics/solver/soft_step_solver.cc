@@ -196,7 +196,7 @@ void SoftStepSolver::Integrate(const StepContext& step) {
     body.travel += touches_link_[i] ? moved.norm() + angle * body.bounding_radius : soft.travel;
   });
   w.DisableNonFiniteBodies();
-  w.UpdateSleep(step);
+  w.sleep_.Update(step, w.moving_bodies_);
 }
 
 }  // namespace rigid_body_sim::physics

@@ -116,4 +116,34 @@ void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal
   sleeping_report_count_ = 0;
 }
 
+// Only moving bodies change state within a step, so only they are checked,
+// on the pool; the few that fail are disabled here, in their order.
+void WorldImpl::DisableNonFiniteBodies() {
+  non_finite_.resize(moving_bodies_.size());
+  constexpr std::size_t kBodiesPerChunk = 256;
+  pool_->ParallelFor(moving_bodies_.size(), kBodiesPerChunk, [this](std::size_t k) {
+    const Body& body = bodies_[moving_bodies_[k]];
+    non_finite_[k] = body.in_use && !body.is_static && !body.disabled && !body.HasFiniteState();
+  });
+  for (std::size_t k = 0; k < moving_bodies_.size(); ++k) {
+    // Its cached pairs are no longer seen from the next step on, and go.
+    if (non_finite_[k]) DisableBody(moving_bodies_[k]);
+  }
+}
+
+// Out of the simulation until it is given a finite state: asleep, out of
+// the broad phase, and reported once in non_finite_bodies_.
+void WorldImpl::DisableBody(std::uint32_t index) {
+  Body& body = bodies_[index];
+  body.disabled = true;
+  body.awake = false;
+  woke_since_prune_ = true;
+  collision_.RemoveProxy(index);
+  const BodyId id{index, body.generation};
+  if (std::find(non_finite_bodies_.begin(), non_finite_bodies_.end(), id) ==
+      non_finite_bodies_.end()) {
+    non_finite_bodies_.push_back(id);
+  }
+}
+
 }  // namespace rigid_body_sim::physics

@@ -141,7 +141,7 @@ Result<BodyId> WorldImpl::CreateBody(const BodyDef& def) {
   }
   id.generation = bodies_[id.index].generation;
   ++body_count_;
-  RestartSleepWindow(id.index);
+  sleep_.RestartWindow(id.index);
   collision_.AddBody(id.index);
   return id;
 }
@@ -211,7 +211,7 @@ Status WorldImpl::SetState(BodyId id, const Pose& world_from_body, const Vec3& l
   }
   body.disabled = false;
   SetBodyState(world_from_body, linear_velocity, angular_velocity, &body);
-  RestartSleepWindow(id.index);
+  sleep_.RestartWindow(id.index);
   // Teleported: last step's contacts and impulses no longer apply, and
   // whatever rested on the body must notice that it left.
   WakeTouching(id.index);
@@ -270,11 +270,7 @@ void WorldImpl::Wake(std::uint32_t index) {
   body.awake = true;
   body.sleep_time = 0.0;
   body.speeding_up_time = 0.0;
-  RestartSleepWindow(index);
-}
-
-void WorldImpl::RestartSleepWindow(std::uint32_t index) {
-  if (index < sleep_windows_.size()) sleep_windows_[index] = SleepWindow{};
+  sleep_.RestartWindow(index);
 }
 
 void WorldImpl::WakeTouching(std::uint32_t index) {

@@ -17,13 +17,12 @@
 #include "physics/collision/collision_system.h"
 #include "physics/contact/contact_cache.h"
 #include "physics/dynamics/integrator.h"
-#include "physics/dynamics/sleep_window.h"
+#include "physics/dynamics/sleep_system.h"
 #include "physics/solver/contact_solver.h"
 #include "physics/solver/motion_solver.h"
 #include "physics/solver/support_balance.h"
 #include "physics/world/step_context.h"
 #include "physics/world/task_pool.h"
-#include "physics/world/union_find.h"
 #include "rigid_body_sim/physics/articulation.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/contact.h"
@@ -107,8 +106,6 @@ class WorldImpl final : public LinkBodies {
   BodyId BodyIdOf(std::uint32_t index) const override;
   void RestartContacts(std::uint32_t body) override;
   void Wake(std::uint32_t body);
-  // Starts the body's sleep window again (it woke, was created or moved).
-  void RestartSleepWindow(std::uint32_t body);
   // Wakes every body that touched `body` in the last step.
   void WakeTouching(std::uint32_t body);
 
@@ -129,11 +126,8 @@ class WorldImpl final : public LinkBodies {
   std::size_t ReportSleepingContacts(const StepContext& step);
   void WriteReports(std::size_t m, const std::vector<ShapePairContact*>& pairs, double dt,
                     bool impacts_only);
-  // Stage 5's end, both solvers' (dynamics/step_sleep.cc).
-  void UpdateSleep(const StepContext& step);
-  bool UpdateSpeedingUp(const StepContext& step, Body* body) const;
-  double QuietTime(const StepContext& step, const SleepWindowLimits& limits, bool island_has_link,
-                   std::uint32_t i);
+  // Stage 5's end, both solvers' (step_guard.cc): bodies whose state is
+  // not finite are disabled.
   void DisableNonFiniteBodies();
   void DisableBody(std::uint32_t index);
   // The step guard (step_guard.cc), around stages 1-5: bodies whose state
@@ -164,16 +158,6 @@ class WorldImpl final : public LinkBodies {
   std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
   std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
-  std::vector<SleepWindow> sleep_windows_;    // the sleep test's, per body slot (UpdateSleep)
-  // UpdateSleep's per-step buffers, kept so that a step does not allocate.
-  struct SleepScratch {
-    UnionFind islands;
-    std::vector<char> island_has_link;
-    std::vector<double> island_sleep_time;
-    std::vector<std::array<std::uint32_t, 2>> edges;  // per touching pair: bodies to join
-    std::vector<std::uint32_t> root;                  // per moving body: its island
-    std::vector<double> quiet_time;                   // s, per moving body
-  } sleep_scratch_;
   std::vector<ContactReport> contacts_;
   std::vector<ContactReport> collision_log_;
   // ReportContacts' scratch: where each manifold's reports start, and
@@ -199,6 +183,7 @@ class WorldImpl final : public LinkBodies {
   std::vector<ShapePairContact*> rigid_pairs_;  // the touching pairs without a link
   ArticulationSystem articulations_{&bodies_, this};
   CollisionSystem collision_{{&bodies_, &contact_cache_, &settings_, &articulations_}};
+  SleepSystem sleep_{{&bodies_, &contact_cache_, &settings_, &articulations_}};
 };
 
 }  // namespace rigid_body_sim::physics
