@@ -15,6 +15,7 @@
 #include "physics/articulation/articulation_solver.h"
 #include "physics/articulation/free_motion.h"
 #include "physics/contact/contact_cache.h"
+#include "physics/solver/contact_reports.h"
 #include "physics/world/step_context.h"
 #include "physics/world/union_find.h"
 #include "rigid_body_sim/physics/articulation.h"
@@ -33,9 +34,6 @@ class LinkBodies {
   virtual BodyId BodyIdOf(std::uint32_t index) const = 0;
   // The body was teleported: what touched it wakes, its contacts are forgotten.
   virtual void RestartContacts(std::uint32_t body) = 0;
-  virtual ContactReport MakeReport(const ShapePairContact& pair, int point,
-                                   const std::array<Vec3, 2>& tangent,
-                                   const StepContext& step) const = 0;
 
  protected:
   ~LinkBodies() = default;
@@ -124,9 +122,8 @@ class ArticulationSystem {
   const std::vector<ShapePairContact*>& link_pairs() const { return link_pairs_; }
   void Solve(const StepContext& step);
   // Keeps the link pairs' impulses for the next warm start and reports
-  // their points.
-  void ReportContacts(const StepContext& step, std::vector<ContactReport>* contacts,
-                      std::vector<ContactReport>* collision_log);
+  // their points in *reports, after the rigid pairs'.
+  void ReportContacts(const StepContext& step, ContactReports* reports);
   // Stage 5: each articulation takes the state its solve chose, and its
   // links follow.
   void Move();

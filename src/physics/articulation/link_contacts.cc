@@ -223,10 +223,8 @@ void ArticulationSystem::CorrectLinkPenetration(const StepContext& step,
 }
 
 // Keeps the link pairs' impulses for next step's warm start and reports
-// their points, as ReportContacts does for the rigid pairs.
-void ArticulationSystem::ReportContacts(const StepContext& step,
-                                        std::vector<ContactReport>* contacts,
-                                        std::vector<ContactReport>* collision_log) {
+// their points, as ContactReports::ReportSolved does for the rigid pairs.
+void ArticulationSystem::ReportContacts(const StepContext& step, ContactReports* reports) {
   const std::vector<ConstraintRow>& rows = solver_.rows();
   for (std::size_t m = 0; m < link_pairs_.size(); ++m) {
     ShapePairContact& pair = *link_pairs_[m];
@@ -244,10 +242,10 @@ void ArticulationSystem::ReportContacts(const StepContext& step,
                         point.position_world};
       const bool touching = point.separation <= step.settings->solver.contact_tolerance;
       if (!touching && normal.impulse <= 0.0) continue;
-      ContactReport& report = contacts->emplace_back(world_.MakeReport(pair, i, tangent, step));
+      ContactReport report = reports->MakeReport(pair, i, tangent, step);
       const bool colliding = normal.colliding && normal.impulse > 0.0;
       report.type = colliding ? ContactType::kColliding : ContactType::kResting;
-      if (colliding) collision_log->push_back(report);
+      reports->Append(report);
     }
   }
 }

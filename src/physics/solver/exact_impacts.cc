@@ -141,7 +141,7 @@ void ExactSolver::SubStep(const std::vector<std::uint32_t>& island, const StepCo
   }
   world_.moving_bodies_ = island;
   SolveTouching(step, touching);
-  world_.ReportContacts(touching, step, /*impacts_only=*/true);
+  world_.reports_.ReportSolved(touching, step, /*impacts_only=*/true);
   DriftBodies(step);
   BoundBodyMotion(step);
   ResolveImpacts(step, FindImpacts(step, pairs), touching, round);

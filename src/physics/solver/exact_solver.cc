@@ -78,8 +78,8 @@ void ExactSolver::SolveContacts(const StepContext& step) {
   world_.articulations_.TakeLinkPairs(world_.contact_cache_.touching(), &world_.rigid_pairs_);
   SolveTouching(step, world_.rigid_pairs_);
   world_.articulations_.Solve(step);
-  world_.ReportContacts(world_.rigid_pairs_, step, /*impacts_only=*/false);
-  world_.articulations_.ReportContacts(step, &world_.contacts_, &world_.collision_log_);
+  world_.reports_.ReportSolved(world_.rigid_pairs_, step, /*impacts_only=*/false);
+  world_.articulations_.ReportContacts(step, &world_.reports_);
 }
 
 // The contact solve of the touching pairs over dt, for the bodies of

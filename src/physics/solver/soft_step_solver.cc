@@ -75,8 +75,8 @@ void SoftStepSolver::Solve(const StepContext& step) {
   StoreVelocities(step);
   w.DisableNonFiniteBodies();
   w.articulations_.Solve(step);
-  w.ReportContacts(w.rigid_pairs_, step, /*impacts_only=*/false);
-  w.articulations_.ReportContacts(step, &w.contacts_, &w.collision_log_);
+  w.reports_.ReportSolved(w.rigid_pairs_, step, /*impacts_only=*/false);
+  w.articulations_.ReportContacts(step, &w.reports_);
 }
 
 // A new support starts from the load it would carry at rest (the exact

@@ -93,7 +93,7 @@ void WorldImpl::GuardAfterStep() {
 }
 
 void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal) {
-  FlushReports();
+  reports_.ForgetBody(index, pool_.get());
   Body& body = bodies_[index];
   body.position = world_from_principal.translation;
   body.orientation = world_from_principal.rotation;
@@ -105,15 +105,6 @@ void WorldImpl::FreezeBody(std::uint32_t index, const Pose& world_from_principal
   body.UpdateDerived();
   DisableBody(index);
   contact_cache_.RemoveBody(index);
-  const auto touches = [index](const ContactReport& contact) {
-    return contact.body_a.index == index || contact.body_b.index == index;
-  };
-  contacts_.erase(std::remove_if(contacts_.begin(), contacts_.end(), touches), contacts_.end());
-  collision_log_.erase(std::remove_if(collision_log_.begin(), collision_log_.end(), touches),
-                       collision_log_.end());
-  // The sleeping pairs' reports at the front of contacts_ are made afresh.
-  sleeping_reports_version_ = ~std::uint64_t{0};
-  sleeping_report_count_ = 0;
 }
 
 // Only moving bodies change state within a step, so only they are checked,

@@ -248,9 +248,7 @@ Status WorldImpl::ApplyTorque(BodyId id, const Vec3& torque_world) {
 
 void WorldImpl::Restart() {
   time_ = 0.0;
-  pending_reports_.pending = false;
-  contacts_.clear();
-  collision_log_.clear();
+  reports_.Clear();
   contact_cache_.Clear();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_[i].in_use && !bodies_[i].is_static) Wake(i);
@@ -274,8 +272,7 @@ void WorldImpl::Wake(std::uint32_t index) {
 }
 
 void WorldImpl::WakeTouching(std::uint32_t index) {
-  FlushReports();
-  for (const ContactReport& contact : contacts_) {
+  for (const ContactReport& contact : reports_.contacts(pool_.get())) {
     if (contact.body_a.index != index && contact.body_b.index != index) continue;
     for (const BodyId other : {contact.body_a, contact.body_b}) {
       if (other.index != index && IsValid(other) && !bodies_[other.index].is_static) {
@@ -285,18 +282,12 @@ void WorldImpl::WakeTouching(std::uint32_t index) {
   }
 }
 
-std::vector<ContactReport> WorldImpl::TakeCollisionLog() {
-  std::vector<ContactReport> log;
-  log.swap(collision_log_);
-  return log;
-}
-
 void WorldImpl::Step() {
   const StepContext step(settings_, pool_.get());
   non_finite_bodies_.clear();
   // The last step's reports that nobody read are never written: this
   // step's take their place.
-  pending_reports_.pending = false;
+  reports_.DiscardPending();
   // Wall time since the previous lap, ms; steady_clock costs tens of
   // nanoseconds a read, nothing next to a stage.
   std::chrono::steady_clock::time_point lap_start = std::chrono::steady_clock::now();

@@ -18,6 +18,7 @@
 #include "physics/contact/contact_cache.h"
 #include "physics/dynamics/integrator.h"
 #include "physics/dynamics/sleep_system.h"
+#include "physics/solver/contact_reports.h"
 #include "physics/solver/contact_solver.h"
 #include "physics/solver/motion_solver.h"
 #include "physics/solver/support_balance.h"
@@ -63,16 +64,12 @@ class WorldImpl final : public LinkBodies {
   void Restart();
   const std::vector<BodyId>& non_finite_bodies() const { return non_finite_bodies_; }
   // The last step's reports, written first if they are not yet
-  // (ReportContacts).
-  const std::vector<ContactReport>& contacts() {
-    FlushReports();
-    return contacts_;
-  }
-  // Writes the reports ReportContacts left to be written when read: before
-  // contacts_ is read, and before a call changes the pairs or the bodies'
-  // slots they are made of.
-  void FlushReports();
-  std::vector<ContactReport> TakeCollisionLog();
+  // (solver/contact_reports.h).
+  const std::vector<ContactReport>& contacts() { return reports_.contacts(pool_.get()); }
+  // Writes the reports the step left to be written when read: before a call
+  // changes the pairs or the bodies' slots they are made of.
+  void FlushReports() { reports_.Flush(pool_.get()); }
+  std::vector<ContactReport> TakeCollisionLog() { return reports_.TakeCollisionLog(); }
 
   // Articulations (articulation/articulation_system.h).
   Result<ArticulationId> CreateArticulation(const ArticulationDef& def) {
@@ -121,11 +118,6 @@ class WorldImpl final : public LinkBodies {
   }
   // What both solvers' stage 4 shares (step_solver.cc).
   void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
-  void ReportContacts(const std::vector<ShapePairContact*>& pairs, const StepContext& step,
-                      bool impacts_only);
-  std::size_t ReportSleepingContacts(const StepContext& step);
-  void WriteReports(std::size_t m, const std::vector<ShapePairContact*>& pairs, double dt,
-                    bool impacts_only);
   // Stage 5's end, both solvers' (step_guard.cc): bodies whose state is
   // not finite are disabled.
   void DisableNonFiniteBodies();
@@ -139,9 +131,6 @@ class WorldImpl final : public LinkBodies {
   // On the solver manifolds (BuildSolverManifolds).
   std::vector<UprightSupport> SeedNewSupportLoads(const StepContext& step);
   SupportBalanceInput SupportInput(const StepContext& step) const;
-  ContactReport MakeReport(const ShapePairContact& pair, int point,
-                           const std::array<Vec3, 2>& tangent,
-                           const StepContext& step) const override;
 
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
@@ -152,28 +141,11 @@ class WorldImpl final : public LinkBodies {
   double time_ = 0.0;
   ContactCache contact_cache_;
   bool woke_since_prune_ = false;  // a sleeping body woke or was disabled since the last stage 3
-  // contacts_ begins with the reports of the sleeping pairs, made when
-  // their list last changed (its version is kept here).
-  std::uint64_t sleeping_reports_version_ = ~std::uint64_t{0};
-  std::size_t sleeping_report_count_ = 0;
   ContactSolver solver_;
+  ContactReports reports_{{&bodies_, &solver_, &contact_cache_, &settings_}};
   std::vector<std::uint32_t> moving_bodies_;  // awake and enabled at stage 4 of this step
-  std::vector<ContactReport> contacts_;
-  std::vector<ContactReport> collision_log_;
-  // ReportContacts' scratch: where each manifold's reports start, and
-  // whether they hold a collision (those are written at once).
-  std::vector<std::uint32_t> report_offsets_;
-  std::vector<std::uint8_t> report_collided_;
   // UpdateContactCache's scratch: per touching pair, whether a body sleeps.
   std::vector<std::uint8_t> has_sleeper_;
-  // What FlushReports needs of the last ReportContacts: its pairs (the
-  // touching pairs without a link, rigid_pairs_), its step and its kind.
-  struct PendingReports {
-    const std::vector<ShapePairContact*>* pairs = nullptr;
-    double dt = 0.0;  // s
-    bool impacts_only = false;
-    bool pending = false;  // some reports are not written yet
-  } pending_reports_;
   std::vector<BodyId> non_finite_bodies_;
   std::vector<Pose> guard_start_poses_;     // world_from_principal at the guard's start, per slot
   std::vector<std::uint8_t> guard_failed_;  // the guards' scratch, per slot
