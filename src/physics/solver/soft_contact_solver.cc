@@ -120,34 +120,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   lanes_ = input.settings.simd_lanes;
   compact_blocks_from_ = input.settings.compact_blocks_from;
   may_bounce_.store(false, std::memory_order_relaxed);
-  moving_.clear();
-  moving_mask_.assign(bodies->size(), 0);
-  states_.resize(bodies->size());
-  auto load = [&](std::uint32_t i) {
-    const SoftBody& body = (*bodies)[i];
-    states_[i] = State{body.linear_velocity, body.angular_velocity, Vec3::Zero(), Vec3::Zero()};
-  };
-  for (const std::uint32_t i : *input.moving) {
-    if (!(*bodies)[i].moving) continue;
-    moving_.push_back(i);
-    moving_mask_[i] = 1;
-    load(i);
-    (*bodies)[i].delta_rotation = Quat::Identity();
-  }
-  // The manifolds' bodies from the dense list beside them: a manifold is
-  // hundreds of bytes, and walking them here would load each one's line.
-  const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *input.manifold_bodies;
-  assert(pair_bodies.size() == manifolds->size());
-  anchors->resize(manifolds->size());
-  body_a_.resize(manifolds->size());
-  body_b_.resize(manifolds->size());
-  for (std::size_t m = 0; m < pair_bodies.size(); ++m) {
-    const auto [a, b] = pair_bodies[m];
-    if (!moving_mask_[a]) load(a);
-    if (!moving_mask_[b]) load(b);
-    body_a_[m] = a;
-    body_b_[m] = b;
-  }
+  LoadStates(input);
   ColourConstraints(body_a_, body_b_, moving_mask_, &colour_masks_, &colour_of_, &colouring_);
   // The constraints are stored in the colouring's order, so that each pass
   // walks them front to back in memory: constraint k is manifold order[k].
@@ -191,6 +164,40 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     run(0);
   } else {
     pool->RunOnAll(run);
+  }
+}
+
+// The moving bodies' velocities into the states, and the other bodies the
+// manifolds reach as bodies the solve never moves; each manifold's bodies
+// for the colouring.
+void SoftContactSolver::LoadStates(const SoftStepInput& input) {
+  moving_.clear();
+  moving_mask_.assign(bodies_->size(), 0);
+  states_.resize(bodies_->size());
+  auto load = [&](std::uint32_t i) {
+    const SoftBody& body = (*bodies_)[i];
+    states_[i] = State{body.linear_velocity, body.angular_velocity, Vec3::Zero(), Vec3::Zero()};
+  };
+  for (const std::uint32_t i : *input.moving) {
+    if (!(*bodies_)[i].moving) continue;
+    moving_.push_back(i);
+    moving_mask_[i] = 1;
+    load(i);
+    (*bodies_)[i].delta_rotation = Quat::Identity();
+  }
+  // The manifolds' bodies from the dense list beside them: a manifold is
+  // hundreds of bytes, and walking them here would load each one's line.
+  const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *input.manifold_bodies;
+  assert(pair_bodies.size() == manifolds_->size());
+  anchors_->resize(manifolds_->size());
+  body_a_.resize(manifolds_->size());
+  body_b_.resize(manifolds_->size());
+  for (std::size_t m = 0; m < pair_bodies.size(); ++m) {
+    const auto [a, b] = pair_bodies[m];
+    if (!moving_mask_[a]) load(a);
+    if (!moving_mask_[b]) load(b);
+    body_a_[m] = a;
+    body_b_[m] = b;
   }
 }
 

@@ -115,6 +115,7 @@ class SoftContactSolver {
   // The blocks of four constraints of one colour for the lane updates
   // (soft_contact_lanes.h); this thread's share of their preparing and
   // packing, and of their restitution and store after the sub-steps.
+  void LoadStates(const SoftStepInput& input);
   void ListBlocks();
   template <typename PrepareConstraint>
   void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
