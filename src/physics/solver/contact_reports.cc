@@ -194,7 +194,7 @@ void ContactReports::Write(std::size_t m, const std::vector<ShapePairContact*>& 
   }
 }
 
-// Writes the last ReportContacts' reports that are not written yet, on the
+// Writes the last ReportSolved's reports that are not written yet, on the
 // pool. Called before anything reads contacts_ and before anything changes
 // what the reports are made of (the pairs, the solver manifolds, the
 // bodies' slots).
@@ -211,7 +211,7 @@ void ContactReports::Flush(TaskPool* pool) {
 // Sleeping bodies keep the contacts they fell asleep with; their reports are
 // made again only when the list of sleeping pairs changes, and the reports
 // of this step follow them. Returns their count: contacts_ keeps its length
-// until ReportContacts resizes it.
+// until ReportSolved resizes it.
 std::size_t ContactReports::ReportSleeping(const StepContext& step) {
   if (sleeping_version_ != contact_cache_.sleeping_version()) {
     contacts_.clear();

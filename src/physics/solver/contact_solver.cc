@@ -8,6 +8,12 @@
 #include <cmath>
 
 namespace rigid_body_sim::physics {
+namespace {
+
+// Manifolds a thread takes at a time when they are built on the pool.
+constexpr std::size_t kManifoldsPerChunk = 256;
+
+}  // namespace
 
 void ContactSolver::Reset(const SolverSettings& settings, double time_step,
                           std::size_t body_count) {
@@ -16,8 +22,8 @@ void ContactSolver::Reset(const SolverSettings& settings, double time_step,
   time_step_ = time_step;
   // Sized, not cleared: World loads the bodies the contacts reach.
   bodies_.resize(body_count);
-  // The manifolds are sized and built afresh by
-  // WorldImpl::BuildSolverManifolds, which follows.
+  // The manifolds are sized and built afresh by BuildManifolds, which
+  // follows.
   schedules_.resize(1);
   schedules_.front().clear();
 }
@@ -86,6 +92,53 @@ void ContactSolver::RecordStartVelocities() {
           velocities_changed_ ? NormalVelocity(manifold, point) : point.normal_velocity_before;
     }
   }
+}
+
+// One solver manifold per touching pair, with its points' lever arms,
+// combined materials and last step's impulses.
+void ContactSolver::BuildManifolds(const std::vector<ShapePairContact*>& pairs,
+                                   const std::vector<Body>& bodies, TaskPool* pool) {
+  std::vector<SolverManifold>& manifolds = manifolds_;
+  // Resized, not cleared (ContactSolver::Reset keeps them): a manifold with
+  // its four points is 648 bytes, and each is built afresh below, on the pool.
+  manifolds.resize(pairs.size());
+  std::vector<std::array<std::uint32_t, 2>>& manifold_bodies = manifold_bodies_;
+  manifold_bodies.resize(pairs.size());
+  pool->ParallelFor(pairs.size(), kManifoldsPerChunk, [&](std::size_t m) {
+    PrefetchAhead(pairs, m, PrefetchPoints);
+    const ShapePairContact* pair = pairs[m];
+    manifold_bodies[m] = {pair->body_a, pair->body_b};
+    const Body& a = bodies[pair->body_a];
+    const Body& b = bodies[pair->body_b];
+    // Reset field by field: assigning a fresh SolverManifold built all four
+    // points (648 bytes) and copied them. Points past point_count keep an
+    // earlier step's values; nothing reads them.
+    SolverManifold& manifold = manifolds[m];
+    manifold.tangent_world = {Vec3::UnitX(), Vec3::UnitY()};  // as constructed
+    manifold.body_a = pair->body_a;
+    manifold.body_b = pair->body_b;
+    manifold.normal_world = pair->manifold.normal_world;
+    const Material& material_a = a.shapes[pair->shape_a].material;
+    const Material& material_b = b.shapes[pair->shape_b].material;
+    manifold.friction = CombineFriction(material_a.friction, material_b.friction);
+    manifold.restitution = CombineRestitution(material_a.restitution, material_b.restitution);
+    manifold.point_count = pair->manifold.point_count;
+    manifold.new_pair = pair->previous_count == 0;
+    for (int i = 0; i < manifold.point_count; ++i) {
+      const ContactPoint& contact = pair->manifold.points[i];
+      SolverPoint& point = manifold.points[i];
+      point = SolverPoint();
+      point.r_a = contact.position_world - a.position;
+      point.r_b = contact.position_world - b.position;
+      point.separation = contact.separation;
+      point.feature = contact.feature;
+      const CachedImpulse& warm = pair->WarmStart(i);
+      point.normal_impulse = warm.normal_impulse;
+      point.tangent_impulse = warm.tangent_impulse;
+      point.preload = warm.preload;
+      point.carried_approach = warm.approach_velocity;
+    }
+  });
 }
 
 }  // namespace rigid_body_sim::physics

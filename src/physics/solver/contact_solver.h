@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "physics/contact/contact_cache.h"
 #include "physics/contact/contact_frame.h"
 #include "physics/contact/contact_manifold.h"
 #include "physics/solver/resting_batches.h"
@@ -137,9 +138,15 @@ class ContactSolver {
   std::vector<SolverManifold>& manifolds() { return manifolds_; }
   const std::vector<SolverManifold>& manifolds() const { return manifolds_; }
   // Each manifold's (body_a, body_b), beside them: a walk over the bodies
-  // loads 8 bytes a manifold instead of its line (WorldImpl::
-  // BuildSolverManifolds writes both).
+  // loads 8 bytes a manifold instead of its line (BuildManifolds writes
+  // both).
   std::vector<std::array<std::uint32_t, 2>>& manifold_bodies() { return manifold_bodies_; }
+
+  // One solver manifold per touching pair of `pairs`, with its points'
+  // lever arms from `bodies` (the world's slots), combined materials and
+  // last step's impulses, built on `pool`.
+  void BuildManifolds(const std::vector<ShapePairContact*>& pairs, const std::vector<Body>& bodies,
+                      TaskPool* pool);
 
   // Computes the tangent basis of every manifold (r_a and r_b are set by
   // the caller), and classifies each point by v_r before anything acts.

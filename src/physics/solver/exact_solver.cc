@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "physics/dynamics/integrator.h"
+#include "physics/solver/support_balance.h"
 #include "physics/world/world_impl.h"
 
 namespace rigid_body_sim::physics {
@@ -88,8 +89,9 @@ void ExactSolver::SolveTouching(const StepContext& step,
                                 const std::vector<ShapePairContact*>& pairs) {
   world_.solver_.Reset(world_.settings_.solver, step.dt, world_.bodies_.size());
   LoadVelocities(world_.bodies_, world_.moving_bodies_, pairs, &world_.solver_.bodies());
-  world_.BuildSolverManifolds(pairs, step);
-  world_.SeedNewSupportLoads(step);
+  world_.solver_.BuildManifolds(pairs, world_.bodies_, step.pool);
+  SeedNewSupportLoads(SupportInputFor(world_.bodies_, world_.settings_, step.dt),
+                      &world_.solver_.manifolds());
   world_.solver_.Prepare();
 
   world_.solver_.ResolveCollisions();

@@ -46,7 +46,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   w.ListMovingBodies();
   w.articulations_.TakeLinkPairs(w.contact_cache_.touching(), &w.rigid_pairs_);
   w.solver_.Reset(w.settings_.solver, step.dt, w.bodies_.size());
-  w.BuildSolverManifolds(w.rigid_pairs_, step);
+  w.solver_.BuildManifolds(w.rigid_pairs_, w.bodies_, step.pool);
   SeedNewSupports(step);
   LoadBodies(step);
   SoftStepInput input;
@@ -87,9 +87,10 @@ void SoftStepSolver::Solve(const StepContext& step) {
 // the load tracking catches up.
 void SoftStepSolver::SeedNewSupports(const StepContext& step) {
   WorldImpl& w = world_;
-  const std::vector<UprightSupport> supports = w.SeedNewSupportLoads(step);
+  const SupportBalanceInput input = SupportInputFor(w.bodies_, w.settings_, step.dt);
+  const std::vector<UprightSupport> supports = SeedNewSupportLoads(input, &w.solver_.manifolds());
   std::vector<SolverManifold>& manifolds = w.solver_.manifolds();
-  BalanceNewSupports(w.SupportInput(step), supports, &manifolds);
+  BalanceNewSupports(input, supports, &manifolds);
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     if (!manifolds[m].new_pair) continue;
     for (int i = 0; i < manifolds[m].point_count; ++i) {

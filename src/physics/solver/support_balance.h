@@ -12,6 +12,7 @@
 #include "physics/solver/contact_solver.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/types.h"
+#include "rigid_body_sim/physics/world_settings.h"
 
 namespace rigid_body_sim::physics {
 
@@ -21,6 +22,10 @@ struct SupportBalanceInput {
   double dt = 0.0;                 // s
   double contact_tolerance = 0.0;  // m: a point this close touches
 };
+
+// The input for the world's bodies over an interval of dt seconds.
+SupportBalanceInput SupportInputFor(const std::vector<Body>& bodies, const WorldSettings& settings,
+                                    double dt);
 
 // A support seen from the body it holds up: manifold `manifold`, whose
 // normal is within 60 degrees of up, n.up taken upward.
@@ -60,6 +65,14 @@ std::vector<UprightSupport> UprightSupportsHighestFirst(
 void BalanceNewSupports(const SupportBalanceInput& input,
                         const std::vector<UprightSupport>& supports,
                         std::vector<SolverManifold>* manifolds);
+
+// A support that is new this step (a pair that had no point last step, and
+// touches at every point now) starts from the load it would carry at rest:
+// its points' normal impulses in *manifolds are set to it. Returns the
+// upright supports it walked (none when no support is new), for the soft
+// step's spread (BalanceNewSupports).
+std::vector<UprightSupport> SeedNewSupportLoads(const SupportBalanceInput& input,
+                                                std::vector<SolverManifold>* manifolds);
 
 }  // namespace rigid_body_sim::physics
 

@@ -323,4 +323,13 @@ void WorldImpl::Step() {
   time_ += step.dt;
 }
 
+// The bodies that move this step; the stages from here on visit only them,
+// so sleeping bodies cost nothing.
+void WorldImpl::ListMovingBodies() {
+  moving_bodies_.clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (MovesThisStep(bodies_[i])) moving_bodies_.push_back(i);
+  }
+}
+
 }  // namespace rigid_body_sim::physics

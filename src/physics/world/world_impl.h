@@ -21,7 +21,6 @@
 #include "physics/solver/contact_reports.h"
 #include "physics/solver/contact_solver.h"
 #include "physics/solver/motion_solver.h"
-#include "physics/solver/support_balance.h"
 #include "physics/world/step_context.h"
 #include "physics/world/task_pool.h"
 #include "rigid_body_sim/physics/articulation.h"
@@ -116,8 +115,6 @@ class WorldImpl final : public LinkBodies {
   static bool MovesThisStep(const Body& body) {
     return body.in_use && !body.is_static && body.awake && !body.disabled && body.articulation < 0;
   }
-  // What both solvers' stage 4 shares (step_solver.cc).
-  void BuildSolverManifolds(const std::vector<ShapePairContact*>& pairs, const StepContext& step);
   // Stage 5's end, both solvers' (step_guard.cc): bodies whose state is
   // not finite are disabled.
   void DisableNonFiniteBodies();
@@ -128,9 +125,6 @@ class WorldImpl final : public LinkBodies {
   void GuardBeforeStep(const StepContext& step);
   void GuardAfterStep();
   void FreezeBody(std::uint32_t index, const Pose& world_from_principal);
-  // On the solver manifolds (BuildSolverManifolds).
-  std::vector<UprightSupport> SeedNewSupportLoads(const StepContext& step);
-  SupportBalanceInput SupportInput(const StepContext& step) const;
 
   WorldSettings settings_;
   std::unique_ptr<TaskPool> pool_;               // settings_.threads threads
