@@ -16,6 +16,7 @@
 #include "physics/collision/broad_phase.h"
 #include "physics/contact/contact_cache.h"
 #include "physics/world/step_context.h"
+#include "physics/world/world_parts.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/world_settings.h"
 
@@ -49,17 +50,11 @@ struct PairVisit {
   double travel = 0.0;                // m, Body::travel of both
 };
 
-// What the collision system reads and writes of the world that holds it.
-struct CollisionWorld {
-  std::vector<Body>* bodies = nullptr;  // the world's slots
-  ContactCache* contact_cache = nullptr;
-  const WorldSettings* settings = nullptr;
-  const ArticulationSystem* articulations = nullptr;  // collision groups, skipped pairs
-};
-
 class CollisionSystem {
  public:
-  explicit CollisionSystem(const CollisionWorld& world);
+  // Reads the bodies, the settings and the articulations' collision
+  // groups; writes the contact cache.
+  explicit CollisionSystem(const WorldParts& world);
 
   // Stage 1: every body's swept, fattened box to the broad phase.
   void UpdateBroadPhase(const StepContext& step);

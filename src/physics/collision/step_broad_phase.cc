@@ -71,7 +71,7 @@ bool Holds(const Aabb& outer, const Aabb& inner) {
 
 }  // namespace
 
-CollisionSystem::CollisionSystem(const CollisionWorld& world)
+CollisionSystem::CollisionSystem(const WorldParts& world)
     : bodies_(*world.bodies),
       contact_cache_(*world.contact_cache),
       settings_(*world.settings),

@@ -17,22 +17,17 @@
 #include "physics/dynamics/sleep_window.h"
 #include "physics/world/step_context.h"
 #include "physics/world/union_find.h"
+#include "physics/world/world_parts.h"
 #include "rigid_body_sim/physics/body.h"
 #include "rigid_body_sim/physics/world_settings.h"
 
 namespace rigid_body_sim::physics {
 
-// What the sleep system reads and writes of the world that holds it.
-struct SleepWorld {
-  std::vector<Body>* bodies = nullptr;  // the world's slots
-  const ContactCache* contact_cache = nullptr;
-  const WorldSettings* settings = nullptr;
-  const ArticulationSystem* articulations = nullptr;  // their link pairs keep islands awake
-};
-
 class SleepSystem {
  public:
-  explicit SleepSystem(const SleepWorld& world);
+  // Reads the touching pairs, the settings and the articulations' link
+  // pairs (which keep their islands awake); writes the bodies.
+  explicit SleepSystem(const WorldParts& world);
 
   // Puts to sleep each island of `moving` bodies (the step's, in slot
   // order) that has been quiet for time_to_sleep; does nothing while

@@ -11,7 +11,7 @@
 
 namespace rigid_body_sim::physics {
 
-SleepSystem::SleepSystem(const SleepWorld& world)
+SleepSystem::SleepSystem(const WorldParts& world)
     : bodies_(*world.bodies),
       contact_cache_(*world.contact_cache),
       settings_(*world.settings),

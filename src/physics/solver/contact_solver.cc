@@ -98,22 +98,20 @@ void ContactSolver::RecordStartVelocities() {
 // combined materials and last step's impulses.
 void ContactSolver::BuildManifolds(const std::vector<ShapePairContact*>& pairs,
                                    const std::vector<Body>& bodies, TaskPool* pool) {
-  std::vector<SolverManifold>& manifolds = manifolds_;
-  // Resized, not cleared (ContactSolver::Reset keeps them): a manifold with
-  // its four points is 648 bytes, and each is built afresh below, on the pool.
-  manifolds.resize(pairs.size());
-  std::vector<std::array<std::uint32_t, 2>>& manifold_bodies = manifold_bodies_;
-  manifold_bodies.resize(pairs.size());
+  // Resized, not cleared (Reset keeps them): a manifold with its four
+  // points is 648 bytes, and each is built afresh below, on the pool.
+  manifolds_.resize(pairs.size());
+  manifold_bodies_.resize(pairs.size());
   pool->ParallelFor(pairs.size(), kManifoldsPerChunk, [&](std::size_t m) {
     PrefetchAhead(pairs, m, PrefetchPoints);
     const ShapePairContact* pair = pairs[m];
-    manifold_bodies[m] = {pair->body_a, pair->body_b};
+    manifold_bodies_[m] = {pair->body_a, pair->body_b};
     const Body& a = bodies[pair->body_a];
     const Body& b = bodies[pair->body_b];
     // Reset field by field: assigning a fresh SolverManifold built all four
     // points (648 bytes) and copied them. Points past point_count keep an
     // earlier step's values; nothing reads them.
-    SolverManifold& manifold = manifolds[m];
+    SolverManifold& manifold = manifolds_[m];
     manifold.tangent_world = {Vec3::UnitX(), Vec3::UnitY()};  // as constructed
     manifold.body_a = pair->body_a;
     manifold.body_b = pair->body_b;

@@ -87,9 +87,9 @@ void SoftStepSolver::Solve(const StepContext& step) {
 // the load tracking catches up.
 void SoftStepSolver::SeedNewSupports(const StepContext& step) {
   WorldImpl& w = world_;
-  const SupportBalanceInput input = SupportInputFor(w.bodies_, w.settings_, step.dt);
-  const std::vector<UprightSupport> supports = SeedNewSupportLoads(input, &w.solver_.manifolds());
   std::vector<SolverManifold>& manifolds = w.solver_.manifolds();
+  const SupportBalanceInput input = SupportInputFor(w.bodies_, w.settings_, step.dt);
+  const std::vector<UprightSupport> supports = SeedNewSupportLoads(input, &manifolds);
   BalanceNewSupports(input, supports, &manifolds);
   for (std::size_t m = 0; m < manifolds.size(); ++m) {
     if (!manifolds[m].new_pair) continue;
