@@ -98,7 +98,7 @@ struct ShapePairContact {
 
   // The impulses this step's point i starts from: those of last step's
   // point it matched, or none. Valid until this step's impulses are kept
-  // (WorldImpl::ReportContacts), which overwrites `previous`.
+  // (ContactReports::ReportSolved), which overwrites `previous`.
   const CachedImpulse& WarmStart(int i) const {
     static const CachedImpulse kNone{};
     return warm_from[i] < 0 ? kNone : previous[warm_from[i]];
