@@ -46,20 +46,11 @@ double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
 }  // namespace
 
-// Start loading what preparing constraints [first, end) of the colouring's
-// order reads: their manifolds and friction anchors, and then, once those
-// have arrived, the two bodies whose indices the manifolds hold.
-void SoftContactSolver::PrefetchManifolds(std::uint32_t first, std::uint32_t end) const {
-  for (std::uint32_t k = first; k < end; ++k) {
-    const std::uint32_t m = colouring_.order[k];
-    PrefetchBytes(&(*manifolds_)[m], sizeof(SolverManifold));
-    PrefetchBytes(&(*anchors_)[m], sizeof(FrictionAnchor));
-  }
-}
-
+// Start loading the two bodies of constraints [first, end): the manifolds
+// are read front to back, their bodies in any order.
 void SoftContactSolver::PrefetchBodies(std::uint32_t first, std::uint32_t end) const {
   for (std::uint32_t k = first; k < end; ++k) {
-    const SolverManifold& manifold = (*manifolds_)[colouring_.order[k]];
+    const SolverManifold& manifold = (*manifolds_)[k];
     PrefetchBytes(&(*bodies_)[manifold.body_a], sizeof(SoftBody));
     PrefetchBytes(&(*bodies_)[manifold.body_b], sizeof(SoftBody));
   }
@@ -68,16 +59,14 @@ void SoftContactSolver::PrefetchBodies(std::uint32_t first, std::uint32_t end) c
 // Each block's constraints are prepared into a scratch block of four, in
 // the cache, and packed from there: the lanes keep the only copy. Then this
 // thread's share of the overflow set is prepared into the constraints.
-// Past the cache (compact_), the colouring's order reads the manifolds out
-// of their own order, and each Prepare waited for its manifold's lines: so
-// the manifolds of the block kManifoldsAhead blocks on start loading, and
-// the bodies of the one kBodiesAhead on, whose manifolds have arrived.
+// Past the cache (compact_), each Prepare waited for its bodies' lines: so
+// the bodies of the block kBodiesAhead blocks on start loading.
 template <typename PrepareConstraint>
 void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
                                              const PrepareConstraint& prepare) {
-  const std::vector<std::uint32_t>& start = colouring_.colour_start;
+  const std::vector<std::uint32_t>& start = colouring_->colour_start;
   std::array<Constraint, kBatchLanes> scratch;
-  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+  for (int colour = 0; colour < colouring_->colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
     const auto [begin, end] = ColourBlocks(colour, thread, threads);
     for (std::size_t b = begin; b < end; ++b) {
@@ -90,7 +79,6 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
         auto ahead = [&](std::uint32_t blocks) {
           return std::min<std::uint32_t>(colour_end, first + blocks * kBatchLanes);
         };
-        PrefetchManifolds(ahead(kManifoldsAhead), ahead(kManifoldsAhead + 1));
         PrefetchBodies(ahead(kBodiesAhead), ahead(kBodiesAhead + 1));
       }
       for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
@@ -99,7 +87,7 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
       });
     }
   }
-  const auto [begin, end] = Share(colouring_.overflow_count(), thread, threads);
+  const auto [begin, end] = Share(colouring_->overflow_count(), thread, threads);
   for (std::size_t k = start.back() + begin; k < start.back() + end; ++k) {
     prepare(k, &constraints_[k]);
   }
@@ -120,20 +108,17 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   lanes_ = input.settings.simd_lanes;
   compact_blocks_from_ = input.settings.compact_blocks_from;
   may_bounce_.store(false, std::memory_order_relaxed);
+  colouring_ = input.colouring;
+  assert(colouring_->order.size() == manifolds->size());
   LoadStates(input);
-  ColourConstraints(body_a_, body_b_, moving_mask_, &colour_masks_, &colour_of_, &colouring_);
-  // The constraints are stored in the colouring's order, so that each pass
-  // walks them front to back in memory: constraint k is manifold order[k].
   constraints_.resize(manifolds->size());
-  const std::vector<std::uint32_t>& order = colouring_.order;
   ListBlocks();
   // Every thread prepares, solves and stores its share; the barriers keep
   // the stages apart.
   const int threads = pool->threads();
   SpinBarrier barrier(threads);
   auto prepare = [&](std::size_t k, Constraint* constraint) {
-    const std::uint32_t m = order[k];
-    Prepare(input, *bodies, (*manifolds)[m], (*anchors)[m], constraint);
+    Prepare(input, *bodies, (*manifolds)[k], (*anchors)[k], constraint);
   };
   auto run = [&](int thread) {
     if (!HasBlocks()) {
@@ -146,7 +131,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     RunSubsteps(thread, threads, &barrier);
     // The constraints not in a block: all of them without lanes, else the
     // overflow set.
-    const std::size_t first_scalar = HasBlocks() ? colouring_.colour_start.back() : 0;
+    const std::size_t first_scalar = HasBlocks() ? colouring_->colour_start.back() : 0;
     const auto [begin, end] = Share(constraints_.size() - first_scalar, thread, threads);
     for (std::size_t k = first_scalar + begin; k < first_scalar + end; ++k) {
       Store(k, constraints_[k]);
@@ -168,8 +153,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
 }
 
 // The moving bodies' velocities into the states, and the other bodies the
-// manifolds reach as bodies the solve never moves; each manifold's bodies
-// for the colouring.
+// manifolds reach as bodies the solve never moves.
 void SoftContactSolver::LoadStates(const SoftStepInput& input) {
   moving_.clear();
   moving_mask_.assign(bodies_->size(), 0);
@@ -190,14 +174,9 @@ void SoftContactSolver::LoadStates(const SoftStepInput& input) {
   const std::vector<std::array<std::uint32_t, 2>>& pair_bodies = *input.manifold_bodies;
   assert(pair_bodies.size() == manifolds_->size());
   anchors_->resize(manifolds_->size());
-  body_a_.resize(manifolds_->size());
-  body_b_.resize(manifolds_->size());
-  for (std::size_t m = 0; m < pair_bodies.size(); ++m) {
-    const auto [a, b] = pair_bodies[m];
+  for (const auto& [a, b] : pair_bodies) {
     if (!moving_mask_[a]) load(a);
     if (!moving_mask_[b]) load(b);
-    body_a_[m] = a;
-    body_b_[m] = b;
   }
 }
 
@@ -351,7 +330,7 @@ void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrie
 // its restitution at once.
 void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBarrier* barrier) {
   Constraint c;
-  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+  for (int colour = 0; colour < colouring_->colour_count(); ++colour) {
     // Named copies, not a structured binding: C++17 lambdas cannot capture
     // a binding (clang refuses it).
     const std::pair<std::size_t, std::size_t> share = ColourBlocks(colour, thread, threads);
@@ -368,9 +347,9 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
     });
     if (bounce) barrier->Wait();
   }
-  if (!bounce || colouring_.overflow_count() == 0) return;
+  if (!bounce || colouring_->overflow_count() == 0) return;
   if (thread == 0) {
-    for (std::size_t k = colouring_.colour_start.back(); k < constraints_.size(); ++k) {
+    for (std::size_t k = colouring_->colour_start.back(); k < constraints_.size(); ++k) {
       Restitute(&constraints_[k]);
     }
   }
@@ -378,8 +357,8 @@ void SoftContactSolver::StoreBlocks(bool bounce, int thread, int threads, SpinBa
 }
 
 void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier) {
-  const std::vector<std::uint32_t>& start = colouring_.colour_start;
-  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+  const std::vector<std::uint32_t>& start = colouring_->colour_start;
+  for (int colour = 0; colour < colouring_->colour_count(); ++colour) {
     if (HasBlocks() && pass != Pass::kRestitution) {
       ApplyToBlocks(pass, colour, thread, threads);
     } else {
@@ -391,7 +370,7 @@ void SoftContactSolver::RunPass(Pass pass, int thread, int threads, SpinBarrier*
     }
     barrier->Wait();
   }
-  if (colouring_.overflow_count() == 0) return;
+  if (colouring_->overflow_count() == 0) return;
   if (thread == 0) {
     for (std::size_t k = start.back(); k < constraints_.size(); ++k) {
       Apply(pass, &constraints_[k]);
@@ -414,9 +393,9 @@ std::pair<std::size_t, std::size_t> SoftContactSolver::ColourBlocks(int colour, 
 // floats' conversions (docs/performance.md).
 void SoftContactSolver::ListBlocks() {
   block_start_.assign(1, 0);
-  const std::vector<std::uint32_t>& start = colouring_.colour_start;
+  const std::vector<std::uint32_t>& start = colouring_->colour_start;
   std::size_t count = 0;
-  for (int colour = 0; colour < colouring_.colour_count(); ++colour) {
+  for (int colour = 0; colour < colouring_->colour_count(); ++colour) {
     const std::size_t size = start[colour + 1] - start[colour];
     count += (size + kBatchLanes - 1) / kBatchLanes;
     block_start_.push_back(static_cast<std::uint32_t>(count));
@@ -522,9 +501,8 @@ void SoftContactSolver::StoreAnchor(const Constraint& c, FrictionAnchor* anchor)
 // threshold, and was pushed; else resting), its new preload, and the
 // approach speed of a point that closed but has not touched yet.
 void SoftContactSolver::Store(std::size_t k, const Constraint& c) const {
-  const std::uint32_t m = colouring_.order[k];
-  SolverManifold* manifold = &(*manifolds_)[m];
-  StoreAnchor(c, &(*anchors_)[m]);
+  SolverManifold* manifold = &(*manifolds_)[k];
+  StoreAnchor(c, &(*anchors_)[k]);
   manifold->tangent_world = c.tangent;
   // The friction impulse is shared among the points as their normal
   // impulses are (equally when none pushed).

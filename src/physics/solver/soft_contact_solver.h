@@ -71,6 +71,11 @@ struct SoftStepInput {
   const std::vector<std::uint32_t>* moving = nullptr;
   // Each manifold's (body_a, body_b), in the manifolds' order.
   const std::vector<std::array<std::uint32_t, 2>>* manifold_bodies = nullptr;
+  // The manifolds' colours (ColourConstraints on their bodies, with the
+  // moving bodies those whose SoftBody::moving is set), the manifolds in
+  // its order: colour c is manifolds [colour_start[c], colour_start[c + 1]),
+  // the overflow set last.
+  const ConstraintColouring* colouring = nullptr;
 };
 
 class SoftContactSolver {
@@ -86,8 +91,6 @@ class SoftContactSolver {
   // this step leaves it.
   void Step(const SoftStepInput& input, TaskPool* pool, std::vector<SoftBody>* bodies,
             std::vector<SolverManifold>* manifolds, std::vector<FrictionAnchor>* anchors);
-
-  const ConstraintColouring& colouring() const { return colouring_; }
 
  private:
   using State = SoftRowState;
@@ -119,12 +122,10 @@ class SoftContactSolver {
   void ListBlocks();
   template <typename PrepareConstraint>
   void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
-  void PrefetchManifolds(std::uint32_t first, std::uint32_t end) const;
   void PrefetchBodies(std::uint32_t first, std::uint32_t end) const;
-  // Blocks ahead of the one being prepared whose manifolds, and whose
-  // bodies, start loading (pyramid_90 on one thread: 0.95 of the awake step
-  // without; docs/performance.md).
-  static constexpr std::uint32_t kManifoldsAhead = 4;
+  // Blocks ahead of the one being prepared whose bodies start loading
+  // (pyramid_90 on one thread: 0.95 of the awake step without;
+  // docs/performance.md).
   static constexpr std::uint32_t kBodiesAhead = 2;
   void StoreBlocks(bool bounce, int thread, int threads, SpinBarrier* barrier);
   // The lane updates of `pass` on this thread's share of colour `colour`'s
@@ -144,8 +145,7 @@ class SoftContactSolver {
     }
   }
   void StoreAnchor(const Constraint& constraint, FrictionAnchor* anchor) const;
-  // Constraint k's results into its manifold (colouring_.order[k]) and its
-  // friction anchor.
+  // Constraint k's results into its manifold and its friction anchor.
   void Store(std::size_t k, const Constraint& constraint) const;
 
   std::vector<SoftBody>* bodies_ = nullptr;
@@ -153,17 +153,13 @@ class SoftContactSolver {
   std::vector<FrictionAnchor>* anchors_ = nullptr;
   std::vector<State> states_;          // per body of bodies_
   std::vector<std::uint32_t> moving_;  // indices of the moving bodies
-  // In colour order; with lanes only the overflow set's are written, the
-  // blocks holding the others.
+  // Constraint k is manifold k's; with lanes only the overflow set's are
+  // written, the blocks holding the others.
   std::vector<Constraint> constraints_;
-  ConstraintColouring colouring_;
-  std::vector<std::uint32_t> body_a_;  // per constraint, for the colouring
-  std::vector<std::uint32_t> body_b_;
-  std::vector<std::uint8_t> moving_mask_;  // per body
-  std::vector<std::uint32_t> colour_masks_;
-  std::vector<std::uint8_t> colour_of_;
-  bool lanes_ = true;            // SoftStepSettings::simd_lanes
-  int compact_blocks_from_ = 0;  // SoftStepSettings::compact_blocks_from
+  const ConstraintColouring* colouring_ = nullptr;  // SoftStepInput::colouring
+  std::vector<std::uint8_t> moving_mask_;           // per body
+  bool lanes_ = true;                               // SoftStepSettings::simd_lanes
+  int compact_blocks_from_ = 0;                     // SoftStepSettings::compact_blocks_from
   // The blocks, this step's first block_start_.back() of blocks_ or
   // (compact_) of compact_blocks_; each vector only grows, so a layout met
   // again is not allocated again.

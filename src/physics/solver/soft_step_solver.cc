@@ -21,6 +21,7 @@ class SoftStepSolver final : public MotionSolver {
   void Integrate(const StepContext& step) override;
 
  private:
+  void ColourPairs();
   void SeedNewSupports(const StepContext& step);
   void LoadBodies(const StepContext& step);
   void StoreVelocities(const StepContext& step);
@@ -35,6 +36,16 @@ class SoftStepSolver final : public MotionSolver {
   std::vector<SoftBody> bodies_;            // per body slot
   std::vector<FrictionAnchor> anchors_;     // per manifold
   std::vector<std::uint8_t> touches_link_;  // per body slot, Integrate's
+  // The touching pairs' colours (ColourPairs), and its scratch: each pair's
+  // bodies, the moving ones' mask and their colours' masks, per body slot,
+  // and the pairs before they are put in colour order.
+  ConstraintColouring colouring_;
+  std::vector<std::uint32_t> pair_body_a_;
+  std::vector<std::uint32_t> pair_body_b_;
+  std::vector<std::uint8_t> moving_mask_;
+  std::vector<std::uint32_t> colour_masks_;
+  std::vector<std::uint8_t> colour_of_;
+  std::vector<ShapePairContact*> unordered_pairs_;
 };
 
 std::unique_ptr<MotionSolver> MakeSoftStepSolver(WorldImpl* world) {
@@ -45,6 +56,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   WorldImpl& w = world_;
   w.ListMovingBodies();
   w.articulations_.TakeLinkPairs(w.contact_cache_.touching(), &w.rigid_pairs_);
+  ColourPairs();
   w.solver_.Reset(w.settings_.solver, step.dt, w.bodies_.size());
   w.solver_.BuildManifolds(w.rigid_pairs_, w.bodies_, step.pool);
   SeedNewSupports(step);
@@ -58,6 +70,7 @@ void SoftStepSolver::Solve(const StepContext& step) {
   // of a millimetre up.
   input.moving = &w.moving_bodies_;
   input.manifold_bodies = &w.solver_.manifold_bodies();
+  input.colouring = &colouring_;
   input.touch_tolerance =
       std::max(w.settings_.solver.contact_tolerance, 0.1 * w.settings_.contact_margin);
   // The anchors to and from the pairs' cache entries on the pool: each
@@ -77,6 +90,31 @@ void SoftStepSolver::Solve(const StepContext& step) {
   w.articulations_.Solve(step);
   w.reports_.ReportSolved(w.rigid_pairs_, step, /*impacts_only=*/false);
   w.articulations_.ReportContacts(step, &w.reports_);
+}
+
+// The touching pairs coloured (constraint_colouring.h) and put in colour
+// order, before their manifolds are built: the manifolds, the rows and
+// their blocks are then all in one order, and every pass of the sub-steps,
+// the preparing and the store reads and writes the manifolds front to back.
+// In the cache's order, each colour was a stride through the manifolds,
+// which outgrow the cache in the big scenes (docs/performance.md, "The
+// soft step's manifolds in colour order").
+void SoftStepSolver::ColourPairs() {
+  WorldImpl& w = world_;
+  std::vector<ShapePairContact*>& pairs = w.rigid_pairs_;
+  moving_mask_.assign(w.bodies_.size(), 0);
+  for (const std::uint32_t i : w.moving_bodies_) moving_mask_[i] = 1;
+  pair_body_a_.resize(pairs.size());
+  pair_body_b_.resize(pairs.size());
+  for (std::size_t m = 0; m < pairs.size(); ++m) {
+    pair_body_a_[m] = pairs[m]->body_a;
+    pair_body_b_[m] = pairs[m]->body_b;
+  }
+  ColourConstraints(pair_body_a_, pair_body_b_, moving_mask_, &colour_masks_, &colour_of_,
+                    &colouring_);
+  unordered_pairs_.swap(pairs);
+  pairs.resize(unordered_pairs_.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = unordered_pairs_[colouring_.order[k]];
 }
 
 // A new support starts from the load it would carry at rest (the exact
