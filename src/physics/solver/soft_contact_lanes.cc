@@ -14,56 +14,6 @@ static_assert(alignof(decltype(CompactSoftLaneBlock::normal[0])) == sizeof(LaneF
 
 namespace {
 
-// Lane `lane` of the lanes set from x (of the 3-vectors lanes[axis] from
-// v). Into floats only in a compact step, whose rows hold floats' values
-// (NarrowToFloat), so exactly.
-void SetLane(double x, int lane, LaneFloats* lanes) { (*lanes)[lane] = static_cast<float>(x); }
-void SetLane(double x, int lane, LaneDoubles* lanes) { (*lanes)[lane] = x; }
-
-void SetLane(const Vec3& v, int lane, LaneFloats (&lanes)[3]) {
-  for (int axis = 0; axis < 3; ++axis) SetLane(v[axis], lane, &lanes[axis]);
-}
-void SetLane(const Vec3& v, int lane, LaneDoubles (&lanes)[3]) {
-  for (int axis = 0; axis < 3; ++axis) SetLane(v[axis], lane, &lanes[axis]);
-}
-
-template <typename LanePoint>
-void PackPoint(const SoftPoint& from, int lane, LanePoint* to, LaneMask* carried) {
-  SetLane(from.rn_a, lane, to->rn_a);
-  SetLane(from.rn_b, lane, to->rn_b);
-  SetLane(from.ang_a, lane, to->ang_a);
-  SetLane(from.ang_b, lane, to->ang_b);
-  SetLane(from.start_separation, lane, &to->start_separation);
-  SetLane(from.preload, lane, &to->preload);
-  to->normal_mass[lane] = from.normal_mass;
-  to->normal_impulse[lane] = from.normal_impulse;
-  to->max_normal_impulse[lane] = from.max_normal_impulse;
-  to->total_normal_impulse[lane] = from.total_normal_impulse;
-  to->approach_velocity[lane] = from.approach_velocity;
-  to->closed[lane] = from.closed ? -1 : 0;
-  (*carried)[lane] = from.carried ? -1 : 0;
-}
-
-template <typename Block>
-void PackFriction(const SoftConstraint& c, int lane, Block* block) {
-  for (int k = 0; k < 2; ++k) {
-    SetLane(c.tangent[k], lane, block->tangent[k]);
-    SetLane(c.ang_t_a[k], lane, block->ang_t_a[k]);
-    SetLane(c.ang_t_b[k], lane, block->ang_t_b[k]);
-    SetLane(c.slip_start[k], lane, &block->slip_start[k]);
-    block->tangent_impulse[k][lane] = c.tangent_impulse[k];
-    block->total_tangent_impulse[k][lane] = c.total_tangent_impulse[k];
-  }
-  SetLane(c.centre_a, lane, block->centre_a);
-  SetLane(c.centre_b, lane, block->centre_b);
-  SetLane(c.twist_a, lane, block->twist_a);
-  SetLane(c.twist_b, lane, block->twist_b);
-  for (int k = 0; k < 3; ++k) block->tangent_block[k][lane] = c.tangent_block[k];
-  block->twist_mass[lane] = c.twist_mass;
-  SetLane(c.twist_arm, lane, &block->twist_arm);
-  block->twist_impulse[lane] = c.twist_impulse;
-}
-
 // The velocities of a block's bodies, lane l holding its constraint's body
 // A and body B, and their motion since the step began.
 struct LaneBodies {
@@ -426,46 +376,6 @@ template <typename Block>
 }  // namespace
 
 template <typename Block>
-void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int lanes,
-                   const std::vector<std::uint8_t>& moving, Block* block) {
-  // Only the lanes and points that hold a row are written: the others keep
-  // whatever finite values an earlier step left (a new block starts at
-  // zero), which the updates compute with and then discard.
-  block->lanes = lanes;
-  block->max_points = 0;
-  for (int lane = 0; lane < kBatchLanes; ++lane) {
-    block->point_count[lane] = lane < lanes ? constraints[lane].point_count : 0;
-  }
-  for (int lane = 0; lane < kBatchLanes; ++lane) {
-    // A lane without a constraint reads the first lane's bodies, and is
-    // neither written back nor stored.
-    const int from = lane < lanes ? lane : 0;
-    const SoftConstraint& c = constraints[from];
-    block->constraint[lane] = first + static_cast<std::uint32_t>(from);
-    block->body_a[lane] = c.body_a;
-    block->body_b[lane] = c.body_b;
-    block->moves_a[lane] = lane < lanes && moving[c.body_a] != 0;
-    block->moves_b[lane] = lane < lanes && moving[c.body_b] != 0;
-    if (lane >= lanes) continue;
-    block->max_points = std::max(block->max_points, c.point_count);
-    SetLane(c.normal, lane, block->normal);
-    block->inverse_mass_a[lane] = c.inverse_mass_a;
-    block->inverse_mass_b[lane] = c.inverse_mass_b;
-    SetLane(c.friction, lane, &block->friction);
-    SetLane(c.restitution, lane, &block->restitution);
-    SetLane(c.bias_rate, lane, &block->bias_rate);
-    SetLane(c.mass_scale, lane, &block->mass_scale);
-    SetLane(c.impulse_scale, lane, &block->impulse_scale);
-    SetLane(c.anchor_a, lane, block->anchor_a);
-    SetLane(c.anchor_b, lane, block->anchor_b);
-    PackFriction(c, lane, block);
-    for (int i = 0; i < c.point_count; ++i) {
-      PackPoint(c.points[i], lane, &block->points[i], &block->carried[i]);
-    }
-  }
-}
-
-template <typename Block>
 void ExtractSoftConstraint(const Block& block, int lane, bool rows, SoftConstraint* constraint) {
   SoftConstraint& c = *constraint;
   auto get = [lane](const auto& lanes) {
@@ -531,10 +441,6 @@ template <typename Block>
 
 }  // namespace
 
-template void PackSoftBlock(const SoftConstraint*, std::uint32_t, int,
-                            const std::vector<std::uint8_t>&, SoftLaneBlock*);
-template void PackSoftBlock(const SoftConstraint*, std::uint32_t, int,
-                            const std::vector<std::uint8_t>&, CompactSoftLaneBlock*);
 template void ExtractSoftConstraint(const SoftLaneBlock&, int, bool, SoftConstraint*);
 template void ExtractSoftConstraint(const CompactSoftLaneBlock&, int, bool, SoftConstraint*);
 

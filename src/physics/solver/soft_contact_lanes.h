@@ -100,13 +100,6 @@ struct SoftLaneContext {
   double collision_velocity_threshold = 0.0;    // m/s
 };
 
-// Packs constraints[0, lanes), the solver's constraints first to first +
-// lanes - 1, into *block; the other lanes hold no constraint. moving[b] is
-// nonzero for a body the solve writes. Block is SoftLaneBlock or
-// CompactSoftLaneBlock, as for each function below.
-template <typename Block>
-void PackSoftBlock(const SoftConstraint* constraints, std::uint32_t first, int lanes,
-                   const std::vector<std::uint8_t>& moving, Block* block);
 // Lane `lane`'s constraint as the sub-steps left it, with the fields that
 // the store reads (SoftContactSolver::Store) and, with `rows`, the normal
 // rows' that the restitution pass reads (Restitute); the friction rows'

@@ -9,24 +9,6 @@
 namespace rigid_body_sim::physics {
 namespace {
 
-// The implicit spring-damper as a soft row (Catto 2011, "Soft Constraints",
-// GDC; Box2D v3's b2MakeSoft): for frequency f, damping ratio z and step h,
-// the bias rate b and the scales of the row's mass and of its accumulated
-// impulse.
-struct Softness {
-  double bias_rate;
-  double mass_scale;
-  double impulse_scale;
-};
-
-Softness MakeSoftness(double hertz, double damping_ratio, double h) {
-  const double omega = 2.0 * M_PI * hertz;
-  const double a1 = 2.0 * damping_ratio + h * omega;
-  const double a2 = h * omega * a1;
-  const double a3 = 1.0 / (1.0 + a2);
-  return Softness{omega / a1, a2 * a3, a3};
-}
-
 // The share [begin, end) of `count` items that thread `thread` of
 // `threads` takes: contiguous, and the same split on every run.
 std::pair<std::size_t, std::size_t> Share(std::size_t count, int thread, int threads) {
@@ -34,15 +16,6 @@ std::pair<std::size_t, std::size_t> Share(std::size_t count, int thread, int thr
   const std::size_t end = count * static_cast<std::size_t>(thread + 1) / threads;
   return {begin, end};
 }
-
-// x as the rows keep what the sub-steps only read: rounded to a float in a
-// step with compact blocks (SoftStepSettings::compact_blocks_from), so
-// that the scalar update and the lanes compute with what those blocks hold.
-double Kept(bool compact, double x) { return compact ? NarrowToFloat(x) : x; }
-Vec3 Kept(bool compact, const Vec3& x) { return compact ? NarrowToFloat(x) : x; }
-
-// 1 / k for k > 0, else 0 (a row neither body can move).
-double InverseOrZero(double k) { return k > 0.0 ? 1.0 / k : 0.0; }
 
 }  // namespace
 
@@ -56,16 +29,13 @@ void SoftContactSolver::PrefetchBodies(std::uint32_t first, std::uint32_t end) c
   }
 }
 
-// Each block's constraints are prepared into a scratch block of four, in
-// the cache, and packed from there: the lanes keep the only copy. Then this
-// thread's share of the overflow set is prepared into the constraints.
-// Past the cache (compact_), each Prepare waited for its bodies' lines: so
-// the bodies of the block kBodiesAhead blocks on start loading.
-template <typename PrepareConstraint>
-void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
-                                             const PrepareConstraint& prepare) {
+// Each block's constraints are prepared four at a time into its lanes,
+// which keep the only copy; then this thread's share of the overflow set
+// is prepared into the constraints. Past the cache (compact_), each block
+// waited for its bodies' lines: so the bodies of the block kBodiesAhead
+// blocks on start loading.
+void SoftContactSolver::PrepareBlocks(const SoftStepInput& input, int thread, int threads) {
   const std::vector<std::uint32_t>& start = colouring_->colour_start;
-  std::array<Constraint, kBatchLanes> scratch;
   for (int colour = 0; colour < colouring_->colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
     const auto [begin, end] = ColourBlocks(colour, thread, threads);
@@ -75,21 +45,16 @@ void SoftContactSolver::PrepareAndPackBlocks(int thread, int threads,
       const int lanes =
           static_cast<int>(std::min<std::size_t>(kBatchLanes, start[colour + 1] - first));
       if (compact_) {
-        const std::uint32_t colour_end = start[colour + 1];
-        auto ahead = [&](std::uint32_t blocks) {
-          return std::min<std::uint32_t>(colour_end, first + blocks * kBatchLanes);
-        };
-        PrefetchBodies(ahead(kBodiesAhead), ahead(kBodiesAhead + 1));
+        const std::uint32_t ahead =
+            std::min<std::uint32_t>(start[colour + 1], first + kBodiesAhead * kBatchLanes);
+        PrefetchBodies(ahead, std::min<std::uint32_t>(start[colour + 1], ahead + kBatchLanes));
       }
-      for (int lane = 0; lane < lanes; ++lane) prepare(first + lane, &scratch[lane]);
-      WithBlocks([&](auto& blocks) {
-        PackSoftBlock(scratch.data(), first, lanes, moving_mask_, &blocks[b]);
-      });
+      WithBlocks([&](auto& blocks) { PrepareBlock(input, first, lanes, &blocks[b]); });
     }
   }
   const auto [begin, end] = Share(colouring_->overflow_count(), thread, threads);
   for (std::size_t k = start.back() + begin; k < start.back() + end; ++k) {
-    prepare(k, &constraints_[k]);
+    Prepare(input, *bodies_, (*manifolds_)[k], (*anchors_)[k], &constraints_[k]);
   }
 }
 
@@ -117,15 +82,14 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   // the stages apart.
   const int threads = pool->threads();
   SpinBarrier barrier(threads);
-  auto prepare = [&](std::size_t k, Constraint* constraint) {
-    Prepare(input, *bodies, (*manifolds)[k], (*anchors)[k], constraint);
-  };
   auto run = [&](int thread) {
     if (!HasBlocks()) {
       const auto [begin, end] = Share(constraints_.size(), thread, threads);
-      for (std::size_t k = begin; k < end; ++k) prepare(k, &constraints_[k]);
+      for (std::size_t k = begin; k < end; ++k) {
+        Prepare(input, *bodies, (*manifolds)[k], (*anchors)[k], &constraints_[k]);
+      }
     } else {
-      PrepareAndPackBlocks(thread, threads, prepare);
+      PrepareBlocks(input, thread, threads);
     }
     barrier.Wait();
     RunSubsteps(thread, threads, &barrier);
@@ -178,130 +142,6 @@ void SoftContactSolver::LoadStates(const SoftStepInput& input) {
     if (!moving_mask_[a]) load(a);
     if (!moving_mask_[b]) load(b);
   }
-}
-
-// A manifold's rows: each point's Jacobian, row mass and the impulse it
-// starts from (the step's cached impulse shared equally among the
-// sub-steps), and its friction rows.
-void SoftContactSolver::Prepare(const SoftStepInput& input, const std::vector<SoftBody>& bodies,
-                                const SolverManifold& manifold, const FrictionAnchor& anchor,
-                                Constraint* constraint) {
-  Constraint& c = *constraint;
-  const SoftBody& a = bodies[manifold.body_a];
-  const SoftBody& b = bodies[manifold.body_b];
-  c.body_a = manifold.body_a;
-  c.body_b = manifold.body_b;
-  // What the sub-steps only read is rounded to floats in a compact step
-  // (Kept); the masses and impulses stay doubles.
-  c.normal = Kept(compact_, manifold.normal_world);
-  c.tangent = TangentBasis(c.normal);
-  for (Vec3& t : c.tangent) t = Kept(compact_, t);
-  c.inverse_mass_a = a.inverse_mass;
-  c.inverse_mass_b = b.inverse_mass;
-  c.friction = Kept(compact_, manifold.friction);
-  c.restitution = Kept(compact_, manifold.restitution);
-  // A spring stiffer than a quarter of the sub-step rate is not followed by
-  // one iteration a sub-step (Box2D v3 caps it the same way); a contact
-  // with a body that does not move takes twice the frequency.
-  const double max_hertz = 0.25 / h_;
-  const double hertz = input.settings.contact_hertz * (a.moving && b.moving ? 1.0 : 2.0);
-  const Softness soft =
-      MakeSoftness(std::min(hertz, max_hertz), input.settings.contact_damping_ratio, h_);
-  c.bias_rate = Kept(compact_, soft.bias_rate);
-  c.mass_scale = Kept(compact_, soft.mass_scale);
-  c.impulse_scale = Kept(compact_, soft.impulse_scale);
-  c.point_count = manifold.point_count;
-  const double share = 1.0 / substeps_;
-  for (int i = 0; i < c.point_count; ++i) {
-    const SolverPoint& from = manifold.points[i];
-    Point& p = c.points[i];
-    p.rn_a = Kept(compact_, from.r_a.cross(c.normal));
-    p.rn_b = Kept(compact_, from.r_b.cross(c.normal));
-    p.ang_a = Kept(compact_, a.inverse_inertia_world * p.rn_a);
-    p.ang_b = Kept(compact_, b.inverse_inertia_world * p.rn_b);
-    p.start_separation = Kept(compact_, from.separation);
-    p.normal_mass =
-        InverseOrZero(a.inverse_mass + b.inverse_mass + p.rn_a.dot(p.ang_a) + p.rn_b.dot(p.ang_b));
-    p.normal_impulse = share * std::max(from.normal_impulse, 0.0);
-    p.preload = Kept(compact_, share * std::max(from.preload, 0.0));
-    p.max_normal_impulse = 0.0;
-    p.total_normal_impulse = 0.0;
-    // A point that closed at the end of the last step, before it touched,
-    // keeps the speed it closed at (the speculative row has slowed it).
-    p.closed = from.carried_approach < 0.0;
-    p.carried = p.closed;
-    if (from.carried_approach < -collision_velocity_threshold_) {
-      may_bounce_.store(true, std::memory_order_relaxed);
-    }
-    p.approach_velocity = p.closed
-                              ? from.carried_approach
-                              : c.normal.dot(a.linear_velocity - b.linear_velocity) +
-                                    p.rn_a.dot(a.angular_velocity) - p.rn_b.dot(b.angular_velocity);
-    p.touched = false;
-  }
-  PrepareFriction(a, b, manifold, anchor, share, &c);
-}
-
-// The friction rows at the centroid c of the manifold's points: the tangent
-// block (K_t)_kl = (1/m_a + 1/m_b) t_k.t_l + (c_a x t_k).I_a^-1 (c_a x t_l)
-// + (B's likewise), inverted, and the twist row's mass
-// 1 / (n.(I_a^-1 + I_b^-1) n); they start from the manifold's cached tangent
-// impulses, summed, and from its anchors.
-void SoftContactSolver::PrepareFriction(const SoftBody& a, const SoftBody& b,
-                                        const SolverManifold& manifold,
-                                        const FrictionAnchor& anchor, double share,
-                                        Constraint* c) const {
-  Vec3 centre_a = Vec3::Zero();
-  Vec3 centre_b = Vec3::Zero();
-  c->tangent_impulse = {0.0, 0.0};
-  for (int i = 0; i < c->point_count; ++i) {
-    centre_a += manifold.points[i].r_a;
-    centre_b += manifold.points[i].r_b;
-    c->tangent_impulse[0] += share * manifold.points[i].tangent_impulse[0];
-    c->tangent_impulse[1] += share * manifold.points[i].tangent_impulse[1];
-  }
-  const double inverse_count = c->point_count > 0 ? 1.0 / c->point_count : 0.0;
-  centre_a *= inverse_count;
-  centre_b *= inverse_count;
-  c->twist_arm = 0.0;
-  for (int i = 0; i < c->point_count; ++i) {
-    const Vec3 offset = manifold.points[i].r_a - centre_a;
-    c->twist_arm += inverse_count * (offset - offset.dot(c->normal) * c->normal).norm();
-  }
-  c->twist_arm = Kept(compact_, c->twist_arm);
-  centre_a = Kept(compact_, centre_a);
-  centre_b = Kept(compact_, centre_b);
-  c->centre_a = centre_a;
-  c->centre_b = centre_b;
-  c->anchor_a = anchor.valid ? Kept(compact_, a.orientation * anchor.on_a) : centre_a;
-  c->anchor_b = anchor.valid ? Kept(compact_, b.orientation * anchor.on_b) : centre_b;
-  const Vec3 anchors_apart = a.position + c->anchor_a - b.position - c->anchor_b;
-  for (int k = 0; k < 2; ++k) {
-    const Vec3& t = c->tangent[k];
-    c->ct_a[k] = centre_a.cross(t);
-    c->ct_b[k] = centre_b.cross(t);
-    c->ang_t_a[k] = Kept(compact_, a.inverse_inertia_world * c->ct_a[k]);
-    c->ang_t_b[k] = Kept(compact_, b.inverse_inertia_world * c->ct_b[k]);
-    c->slip_start[k] = Kept(compact_, t.dot(anchors_apart));
-    c->anchor_t_a[k] = c->anchor_a.cross(t);
-    c->anchor_t_b[k] = c->anchor_b.cross(t);
-  }
-  const double inverse_masses = a.inverse_mass + b.inverse_mass;
-  auto block = [&](int k, int l) {
-    return inverse_masses * c->tangent[k].dot(c->tangent[l]) + c->ct_a[k].dot(c->ang_t_a[l]) +
-           c->ct_b[k].dot(c->ang_t_b[l]);
-  };
-  const double kxx = block(0, 0);
-  const double kxy = block(0, 1);
-  const double kyy = block(1, 1);
-  const double det = kxx * kyy - kxy * kxy;
-  c->tangent_block = det > 0.0 ? std::array<double, 3>{kyy / det, -kxy / det, kxx / det}
-                               : std::array<double, 3>{0.0, 0.0, 0.0};
-  c->twist_a = Kept(compact_, a.inverse_inertia_world * c->normal);
-  c->twist_b = Kept(compact_, b.inverse_inertia_world * c->normal);
-  c->twist_mass = InverseOrZero(c->normal.dot(c->twist_a + c->twist_b));
-  c->twist_impulse = 0.0;
-  c->total_tangent_impulse = {0.0, 0.0};
 }
 
 void SoftContactSolver::RunSubsteps(int thread, int threads, SpinBarrier* barrier) {
@@ -404,7 +244,7 @@ void SoftContactSolver::ListBlocks() {
   // update rounds the same rows.
   compact_ = count >= static_cast<std::size_t>(compact_blocks_from_);
   if (!lanes_) return;
-  // Kept from step to step: PackSoftBlock writes what a block's rows use.
+  // Kept from step to step: PrepareBlock writes every field of a block.
   WithBlocks([count](auto& blocks) {
     if (blocks.size() < count) blocks.resize(count);
   });

@@ -99,11 +99,19 @@ class SoftContactSolver {
   enum class Pass { kWarmStart, kSolve, kRelax, kRestitution };
   struct PairVelocities;  // soft_contact_solver.cc
 
+  // The rows' preparing (soft_contact_prepare.cc): a constraint's frame,
+  // as its rows keep it; one constraint for the scalar update; a block's
+  // constraints first to first + lanes - 1 straight into its lanes.
+  struct Frame;
+  Frame MakeFrame(const SoftStepInput& input, const SoftBody& a, const SoftBody& b,
+                  const SolverManifold& manifold, const FrictionAnchor& anchor) const;
   void Prepare(const SoftStepInput& input, const std::vector<SoftBody>& bodies,
                const SolverManifold& manifold, const FrictionAnchor& anchor,
                Constraint* constraint);
-  void PrepareFriction(const SoftBody& a, const SoftBody& b, const SolverManifold& manifold,
-                       const FrictionAnchor& anchor, double share, Constraint* constraint) const;
+  void PrepareFriction(const SoftBody& a, const SoftBody& b, const Frame& frame,
+                       Constraint* constraint) const;
+  template <typename Block>
+  void PrepareBlock(const SoftStepInput& input, std::uint32_t first, int lanes, Block* block);
   // Stage `pass` on the constraints, colour after colour, the overflow
   // last; thread `thread` of `threads` takes its share of each colour.
   void RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier);
@@ -116,12 +124,11 @@ class SoftContactSolver {
   void IntegratePositions(int thread, int threads);
   void RunSubsteps(int thread, int threads, SpinBarrier* barrier);
   // The blocks of four constraints of one colour for the lane updates
-  // (soft_contact_lanes.h); this thread's share of their preparing and
-  // packing, and of their restitution and store after the sub-steps.
+  // (soft_contact_lanes.h); this thread's share of their preparing, and of
+  // their restitution and store after the sub-steps.
   void LoadStates(const SoftStepInput& input);
   void ListBlocks();
-  template <typename PrepareConstraint>
-  void PrepareAndPackBlocks(int thread, int threads, const PrepareConstraint& prepare);
+  void PrepareBlocks(const SoftStepInput& input, int thread, int threads);
   void PrefetchBodies(std::uint32_t first, std::uint32_t end) const;
   // Blocks ahead of the one being prepared whose bodies start loading
   // (pyramid_90 on one thread: 0.95 of the awake step without;
