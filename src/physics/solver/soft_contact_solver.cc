@@ -327,7 +327,8 @@ void SoftContactSolver::StoreAnchor(const Constraint& c, FrictionAnchor* anchor)
   double normal = 0.0;
   for (int i = 0; i < c.point_count; ++i) normal += c.points[i].normal_impulse;
   constexpr double kHeld = 0.999;
-  const double friction = std::hypot(c.tangent_impulse[0], c.tangent_impulse[1]);
+  const double friction = std::sqrt(c.tangent_impulse[0] * c.tangent_impulse[0] +
+                                    c.tangent_impulse[1] * c.tangent_impulse[1]);
   anchor->valid = normal > 0.0 && friction < kHeld * c.friction * normal;
   if (!anchor->valid) return;
   const SoftBody& a = (*bodies_)[c.body_a];
