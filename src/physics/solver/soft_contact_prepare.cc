@@ -1,9 +1,10 @@
 // The soft step's rows prepared from the solver manifolds (docs/design.md,
 // "The soft step"): one constraint at a time for the scalar update and the
 // overflow set (Prepare), or four at a time straight into a block's lanes
-// (PrepareBlock). Both take each constraint's frame (normal, tangents,
-// softness, friction centroid and anchors) from the same scalar code
-// (Frame); the lanes then form the rows' Jacobians, masses and starting
+// (PrepareBlock). Both take each constraint's frame (normal, softness,
+// friction centroid, twist arm and anchors) from the same scalar code
+// (MakeFrame), and the softness from the step's two (MakeSoftnesses); the
+// lanes then form the tangents, the rows' Jacobians, masses and starting
 // impulses with the scalar code's floating-point operations in its order,
 // so a block holds the bits that the scalar rows do (threads_test).
 #include <algorithm>
@@ -255,13 +256,39 @@ struct LanePrepareInput {
   LaneBodySide a;
   LaneBodySide b;
   LaneDoubles normal[3];
-  LaneDoubles tangent[2][3];
 };
+
+// TangentBasis (contact_frame.cc) in each lane, with its operations in its
+// order: t_0 = (n x h) / |n x h| with h = x when |n_x| < 0.57, else y (left
+// as n x h where that is zero); t_1 = n x t_0; both then as the rows keep
+// them (Keep).
+[[gnu::always_inline]] inline void TangentBasisLanes(bool compact, const LaneDoubles (&normal)[3],
+                                                     LaneDoubles (&tangent)[2][3]) {
+  const LaneDoubles zero = {};
+  const LaneDoubles one = zero + 1.0;
+  const LaneDoubles size_x = normal[0] < zero ? -normal[0] : normal[0];
+  const LaneMask use_x = size_x < zero + 0.57;
+  const LaneDoubles helper[3] = {use_x ? one : zero, use_x ? zero : one, zero};
+  LaneDoubles across[3];
+  Cross(normal, helper, across);
+  LaneDoubles squared_norm, norm;
+  Dot(across, across, &squared_norm);
+  for (int lane = 0; lane < kBatchLanes; ++lane) norm[lane] = std::sqrt(squared_norm[lane]);
+  const LaneMask positive = squared_norm > zero;
+  for (int axis = 0; axis < 3; ++axis) {
+    tangent[0][axis] = positive ? across[axis] / norm : across[axis];
+  }
+  Cross(normal, tangent[0], tangent[1]);
+  Keep3(compact, tangent[0]);
+  Keep3(compact, tangent[1]);
+}
 
 template <typename Block>
 [[gnu::always_inline]] inline bool PrepareRowLanes(const LanePrepareInput& in, Block* block) {
   const bool fast = PreparePointLanes(in.context, in.manifolds, in.a, in.b, in.normal, block);
-  PrepareFrictionLanes(in.context, in.a, in.b, in.normal, in.tangent, block);
+  LaneDoubles tangent[2][3];
+  TangentBasisLanes(in.context.compact, in.normal, tangent);
+  PrepareFrictionLanes(in.context, in.a, in.b, in.normal, tangent, block);
   return fast;
 }
 
@@ -280,7 +307,6 @@ RBS_SIMD_CLONES bool PrepareRows(const LanePrepareInput& in, CompactSoftLaneBloc
 // rows' centroid, twist arm, starting impulses and anchors.
 struct SoftContactSolver::Frame {
   Vec3 normal;
-  std::array<Vec3, 2> tangent;
   double friction;
   double restitution;
   double bias_rate;  // 1/s
@@ -294,29 +320,36 @@ struct SoftContactSolver::Frame {
   Vec3 anchor_b;
 };
 
-// A spring stiffer than a quarter of the sub-step rate is not followed by
-// one iteration a sub-step (Box2D v3 caps it the same way); a contact with
-// a body that does not move takes twice the frequency. Friction acts at the
-// points' centroid c, with the twist arm the points' mean distance from it
+// The spring's softness for this step, as the rows keep it: [1] for a
+// contact between two moving bodies, [0] for one with a body that does not
+// move, which takes twice the frequency. A spring stiffer than a quarter of
+// the sub-step rate is not followed by one iteration a sub-step (Box2D v3
+// caps it the same way).
+void SoftContactSolver::MakeSoftnesses(const SoftStepInput& input) {
+  const double max_hertz = 0.25 / h_;
+  for (int both_move = 0; both_move < 2; ++both_move) {
+    const double hertz = input.settings.contact_hertz * (both_move ? 1.0 : 2.0);
+    const Softness soft =
+        MakeSoftness(std::min(hertz, max_hertz), input.settings.contact_damping_ratio, h_);
+    softness_[both_move] = {Kept(compact_, soft.bias_rate), Kept(compact_, soft.mass_scale),
+                            Kept(compact_, soft.impulse_scale)};
+  }
+}
+
+// Friction acts at the points' centroid c, with the twist arm the points' mean distance from it
 // across the normal, from the cached tangent impulses, summed, and from the
 // friction anchors while they hold.
-SoftContactSolver::Frame SoftContactSolver::MakeFrame(const SoftStepInput& input, const SoftBody& a,
-                                                      const SoftBody& b,
+SoftContactSolver::Frame SoftContactSolver::MakeFrame(const SoftBody& a, const SoftBody& b,
                                                       const SolverManifold& manifold,
                                                       const FrictionAnchor& anchor) const {
   Frame f;
   f.normal = Kept(compact_, manifold.normal_world);
-  f.tangent = TangentBasis(f.normal);
-  for (Vec3& t : f.tangent) t = Kept(compact_, t);
   f.friction = Kept(compact_, manifold.friction);
   f.restitution = Kept(compact_, manifold.restitution);
-  const double max_hertz = 0.25 / h_;
-  const double hertz = input.settings.contact_hertz * (a.moving && b.moving ? 1.0 : 2.0);
-  const Softness soft =
-      MakeSoftness(std::min(hertz, max_hertz), input.settings.contact_damping_ratio, h_);
-  f.bias_rate = Kept(compact_, soft.bias_rate);
-  f.mass_scale = Kept(compact_, soft.mass_scale);
-  f.impulse_scale = Kept(compact_, soft.impulse_scale);
+  const KeptSoftness& soft = softness_[a.moving && b.moving ? 1 : 0];
+  f.bias_rate = soft.bias_rate;
+  f.mass_scale = soft.mass_scale;
+  f.impulse_scale = soft.impulse_scale;
   const double share = 1.0 / substeps_;
   Vec3 centre_a = Vec3::Zero();
   Vec3 centre_b = Vec3::Zero();
@@ -346,17 +379,17 @@ SoftContactSolver::Frame SoftContactSolver::MakeFrame(const SoftStepInput& input
 // A manifold's rows: each point's Jacobian, row mass and the impulse it
 // starts from (the step's cached impulse shared equally among the
 // sub-steps), and its friction rows.
-void SoftContactSolver::Prepare(const SoftStepInput& input, const std::vector<SoftBody>& bodies,
-                                const SolverManifold& manifold, const FrictionAnchor& anchor,
-                                Constraint* constraint) {
+void SoftContactSolver::Prepare(const std::vector<SoftBody>& bodies, const SolverManifold& manifold,
+                                const FrictionAnchor& anchor, Constraint* constraint) {
   Constraint& c = *constraint;
   const SoftBody& a = bodies[manifold.body_a];
   const SoftBody& b = bodies[manifold.body_b];
-  const Frame frame = MakeFrame(input, a, b, manifold, anchor);
+  const Frame frame = MakeFrame(a, b, manifold, anchor);
   c.body_a = manifold.body_a;
   c.body_b = manifold.body_b;
   c.normal = frame.normal;
-  c.tangent = frame.tangent;
+  c.tangent = TangentBasis(c.normal);
+  for (Vec3& t : c.tangent) t = Kept(compact_, t);
   c.inverse_mass_a = a.inverse_mass;
   c.inverse_mass_b = b.inverse_mass;
   c.friction = frame.friction;
@@ -442,8 +475,7 @@ void SoftContactSolver::PrepareFriction(const SoftBody& a, const SoftBody& b, co
 // first lane's bodies and frame, with no point, and is neither written back
 // nor stored. Each block field is written: a block is the only copy.
 template <typename Block>
-void SoftContactSolver::PrepareBlock(const SoftStepInput& input, std::uint32_t first, int lanes,
-                                     Block* block) {
+void SoftContactSolver::PrepareBlock(std::uint32_t first, int lanes, Block* block) {
   const std::vector<SoftBody>& bodies = *bodies_;
   LanePrepareInput in;
   in.context = {compact_, 1.0 / substeps_, collision_velocity_threshold_};
@@ -463,12 +495,10 @@ void SoftContactSolver::PrepareBlock(const SoftStepInput& input, std::uint32_t f
     block->moves_b[lane] = lane < lanes && moving_mask_[manifold.body_b] != 0;
     block->point_count[lane] = lane < lanes ? manifold.point_count : 0;
     if (lane < lanes) block->max_points = std::max(block->max_points, manifold.point_count);
-    const Frame frame = MakeFrame(input, a, b, manifold, (*anchors_)[k]);
+    const Frame frame = MakeFrame(a, b, manifold, (*anchors_)[k]);
     SetLane(a, lane, &in.a);
     SetLane(b, lane, &in.b);
     SetLane(frame.normal, lane, in.normal);
-    SetLane(frame.tangent[0], lane, in.tangent[0]);
-    SetLane(frame.tangent[1], lane, in.tangent[1]);
     SetLane(frame.centre_a, lane, centre_a);
     SetLane(frame.centre_b, lane, centre_b);
     SetLane(frame.anchor_a, lane, anchor_a);
@@ -495,9 +525,7 @@ void SoftContactSolver::PrepareBlock(const SoftStepInput& input, std::uint32_t f
   if (PrepareRows(in, block)) may_bounce_.store(true, std::memory_order_relaxed);
 }
 
-template void SoftContactSolver::PrepareBlock(const SoftStepInput&, std::uint32_t, int,
-                                              SoftLaneBlock*);
-template void SoftContactSolver::PrepareBlock(const SoftStepInput&, std::uint32_t, int,
-                                              CompactSoftLaneBlock*);
+template void SoftContactSolver::PrepareBlock(std::uint32_t, int, SoftLaneBlock*);
+template void SoftContactSolver::PrepareBlock(std::uint32_t, int, CompactSoftLaneBlock*);
 
 }  // namespace rigid_body_sim::physics

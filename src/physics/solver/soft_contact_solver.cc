@@ -34,7 +34,7 @@ void SoftContactSolver::PrefetchBodies(std::uint32_t first, std::uint32_t end) c
 // is prepared into the constraints. Past the cache (compact_), each block
 // waited for its bodies' lines: so the bodies of the block kBodiesAhead
 // blocks on start loading.
-void SoftContactSolver::PrepareBlocks(const SoftStepInput& input, int thread, int threads) {
+void SoftContactSolver::PrepareBlocks(int thread, int threads) {
   const std::vector<std::uint32_t>& start = colouring_->colour_start;
   for (int colour = 0; colour < colouring_->colour_count(); ++colour) {
     const std::size_t first_block = block_start_[colour];
@@ -49,12 +49,12 @@ void SoftContactSolver::PrepareBlocks(const SoftStepInput& input, int thread, in
             std::min<std::uint32_t>(start[colour + 1], first + kBodiesAhead * kBatchLanes);
         PrefetchBodies(ahead, std::min<std::uint32_t>(start[colour + 1], ahead + kBatchLanes));
       }
-      WithBlocks([&](auto& blocks) { PrepareBlock(input, first, lanes, &blocks[b]); });
+      WithBlocks([&](auto& blocks) { PrepareBlock(first, lanes, &blocks[b]); });
     }
   }
   const auto [begin, end] = Share(colouring_->overflow_count(), thread, threads);
   for (std::size_t k = start.back() + begin; k < start.back() + end; ++k) {
-    Prepare(input, *bodies_, (*manifolds_)[k], (*anchors_)[k], &constraints_[k]);
+    Prepare(*bodies_, (*manifolds_)[k], (*anchors_)[k], &constraints_[k]);
   }
 }
 
@@ -78,6 +78,7 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
   LoadStates(input);
   constraints_.resize(manifolds->size());
   ListBlocks();
+  MakeSoftnesses(input);
   // Every thread prepares, solves and stores its share; the barriers keep
   // the stages apart.
   const int threads = pool->threads();
@@ -86,10 +87,10 @@ void SoftContactSolver::Step(const SoftStepInput& input, TaskPool* pool,
     if (!HasBlocks()) {
       const auto [begin, end] = Share(constraints_.size(), thread, threads);
       for (std::size_t k = begin; k < end; ++k) {
-        Prepare(input, *bodies, (*manifolds)[k], (*anchors)[k], &constraints_[k]);
+        Prepare(*bodies, (*manifolds)[k], (*anchors)[k], &constraints_[k]);
       }
     } else {
-      PrepareBlocks(input, thread, threads);
+      PrepareBlocks(thread, threads);
     }
     barrier.Wait();
     RunSubsteps(thread, threads, &barrier);

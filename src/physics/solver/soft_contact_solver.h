@@ -103,15 +103,15 @@ class SoftContactSolver {
   // as its rows keep it; one constraint for the scalar update; a block's
   // constraints first to first + lanes - 1 straight into its lanes.
   struct Frame;
-  Frame MakeFrame(const SoftStepInput& input, const SoftBody& a, const SoftBody& b,
-                  const SolverManifold& manifold, const FrictionAnchor& anchor) const;
-  void Prepare(const SoftStepInput& input, const std::vector<SoftBody>& bodies,
-               const SolverManifold& manifold, const FrictionAnchor& anchor,
-               Constraint* constraint);
+  void MakeSoftnesses(const SoftStepInput& input);
+  Frame MakeFrame(const SoftBody& a, const SoftBody& b, const SolverManifold& manifold,
+                  const FrictionAnchor& anchor) const;
+  void Prepare(const std::vector<SoftBody>& bodies, const SolverManifold& manifold,
+               const FrictionAnchor& anchor, Constraint* constraint);
   void PrepareFriction(const SoftBody& a, const SoftBody& b, const Frame& frame,
                        Constraint* constraint) const;
   template <typename Block>
-  void PrepareBlock(const SoftStepInput& input, std::uint32_t first, int lanes, Block* block);
+  void PrepareBlock(std::uint32_t first, int lanes, Block* block);
   // Stage `pass` on the constraints, colour after colour, the overflow
   // last; thread `thread` of `threads` takes its share of each colour.
   void RunPass(Pass pass, int thread, int threads, SpinBarrier* barrier);
@@ -128,7 +128,7 @@ class SoftContactSolver {
   // their restitution and store after the sub-steps.
   void LoadStates(const SoftStepInput& input);
   void ListBlocks();
-  void PrepareBlocks(const SoftStepInput& input, int thread, int threads);
+  void PrepareBlocks(int thread, int threads);
   void PrefetchBodies(std::uint32_t first, std::uint32_t end) const;
   // Blocks ahead of the one being prepared whose bodies start loading
   // (pyramid_90 on one thread: 0.95 of the awake step without;
@@ -180,6 +180,15 @@ class SoftContactSolver {
   double collision_velocity_threshold_ = 0.0;
   double touch_tolerance_ = 0.0;
   double load_tracking_ = 0.0;
+  // The spring's bias rate (1/s), mass scale and impulse scale, as the rows
+  // keep them: [1] between two moving bodies, [0] with one that does not
+  // move (MakeSoftnesses).
+  struct KeptSoftness {
+    double bias_rate;
+    double mass_scale;
+    double impulse_scale;
+  };
+  std::array<KeptSoftness, 2> softness_{};
   // Some point closed faster than the collision threshold this step (or
   // carried such a closing over): the restitution pass has work. Written by
   // any thread, only ever to true, and read after a barrier.
