@@ -4,7 +4,6 @@
 #include <cassert>
 #include <cmath>
 
-#include "physics/contact/contact_frame.h"
 
 namespace rigid_body_sim::physics {
 namespace {
