@@ -1,8 +1,8 @@
 // Articulations in contact, against closed forms: a cart on a rail
 // touching the ground keeps its speed, a box with a flap rests on the
-// ground, rises out of it without launch speed, and bounces to e^2 h, a
-// rigid ball bounces on a link to e^2 h, and a gripper lifts a box without
-// letting it slip.
+// ground and rises out of it without launch speed, a gripper lifts a box
+// without letting it slip, and a link pressing a stack is carried by the
+// ground. Their impacts are link_impact_test.cc.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -110,163 +110,6 @@ TEST(ArticulationContactTest, ArticulationSpawnedIntoTheGroundRisesWithoutLaunch
   }
 }
 
-// A bouncing articulation: the box with its flap, e = 0.5, dropped from
-// h = 0.2 m, rises to e^2 h after its first impact, as a rigid box does
-// (collision_test's BounceTest), and then comes to rest on its face. Before
-// the restitution pass (BounceLinkContacts) the row that stopped it where it
-// touched took its speed, and it rose to 0.012 m instead of 0.05. Resting
-// on the ground, each step's free motion closes its contact at g dt =
-// 0.041 m/s, above the collision threshold; classified by that speed
-// instead of the speed the step starts with, the box hopped at
-// e g dt every step and never rested.
-TEST(ArticulationContactTest, BouncingArticulationRisesToRestitutionSquaredAndRests) {
-  constexpr double kDrop = 0.2;         // m, from the base's rest height
-  constexpr double kRestitution = 0.5;  // the box's; the ground's is 0
-  World world = MakeWorld();
-  AddGround(&world, MakeMaterial(0.8, 0.0));
-  ArticulationDef def = BoxWithFlap(0.1 + kDrop);
-  def.links[0].shapes[0].material = MakeMaterial(0.8, kRestitution);
-  def.joints[0].type = JointType::kRevolute;  // the flap comes to rest at a limit
-  def.joints[0].lower = -0.1;
-  def.joints[0].upper = 0.1;
-  const ArticulationId id = world.CreateArticulation(def).value();
-  const BodyId base = world.ArticulationLinks(id)[0];
-  bool rising = false;
-  double apex = 0.0;
-  for (int step = 0; step < 240 && apex == 0.0; ++step) {
-    const double before = world.GetLinearVelocity(base).z();
-    world.Step();
-    const double after = world.GetLinearVelocity(base).z();
-    rising = rising || (before < 0.0 && after > 0.0);
-    if (rising && after <= 0.0) apex = world.GetPose(base).translation.z() - 0.1;
-  }
-  std::printf("first apex %.5f m, e^2 h = %.5f m\n", apex, kRestitution * kRestitution * kDrop);
-  // It leaves the ground at the time it touches, with e times the speed it
-  // struck with. The apex is sampled at steps, within g dt^2 of the true
-  // one, and the velocity-level steps that meet the ground (q + dt u+)
-  // stand up to g dt^2 / 2 of height each, before and after the impact.
-  // Bounced at the end of the step instead, it rose e v- dt lower (4 mm).
-  EXPECT_NEAR(apex, kRestitution * kRestitution * kDrop, 2.0 * kG * kDt * kDt);
-  for (int step = 0; step < 3 * 240; ++step) world.Step();
-  EXPECT_NEAR(world.GetPose(base).translation.z(), 0.1, 1e-3);
-  for (const BodyId link : world.ArticulationLinks(id)) {
-    EXPECT_LT(world.GetLinearVelocity(link).norm(), 1e-6);
-    EXPECT_LT(world.GetAngularVelocity(link).norm(), 1e-6);
-  }
-}
-
-// A rigid link on a hinge about z (gravity along the axis gives it no
-// torque) swings its 1 cm ball into the face y = 0 of a static box,
-// e = 0.5, no friction. The ball touches at theta_c = -asin(r / L), at
-// t_c = 5.37 steps: the impact step must end at
-// theta_c - e omega (t - t_c), the rebound resolved at t_c, not at the end
-// of the step (a link stopped there and bounced lags e omega 0.63 dt =
-// 4e-3 rad at 3 m/s), and leave at -e omega to 1e-6 relative. The joint
-// moves on q + t u within a step, while the gap follows the sine of q: a
-// time found from the gap's rate at the start of the step was late, 2e-7
-// rad after the rebound at 3 m/s and 6.6e-5 rad at 30 m/s; found from the
-// shapes' gap on the path it is within 1e-10 m of the touch.
-void StrikeAStaticBox(double impact_speed, double box_thickness) {
-  constexpr double kLength = 1.0;       // m, hinge to ball centre
-  constexpr double kRadius = 0.01;      // m
-  constexpr double kRestitution = 0.5;  // both materials
-  constexpr double kStepsToImpact = 5.37;
-  const double contact_angle = -std::asin(kRadius / kLength);
-  const double omega = impact_speed / (kLength * std::cos(contact_angle));
-  const double start_angle = contact_angle - omega * kStepsToImpact * kDt;
-  World world = MakeWorld();
-  BoxSpec wall;
-  wall.size = Vec3(0.2, box_thickness, 0.2);
-  wall.world_from_body = Translation(kLength, 0.5 * box_thickness, 0.0);
-  wall.is_static = true;
-  wall.material = MakeMaterial(0.0, kRestitution);
-  AddBox(&world, wall);
-  ArticulationDef def;
-  def.fixed_base = true;
-  LinkDef arm;
-  arm.mass_properties.mass = 1.0;
-  arm.mass_properties.center_of_mass = Vec3(kLength, 0, 0);
-  arm.mass_properties.inertia_about_com = Mat3::Identity() * 1e-4;
-  ShapeDef ball;
-  ball.geometry = Sphere{kRadius};
-  ball.body_from_shape.translation = Vec3(kLength, 0, 0);
-  ball.material = MakeMaterial(0.0, kRestitution);
-  arm.shapes.push_back(ball);
-  def.links = {Anchor(), arm};
-  JointDef hinge = Hinge(1, 0.0, start_angle);
-  hinge.axis = Vec3::UnitZ();
-  hinge.velocity = omega;
-  def.joints = {hinge};
-  const ArticulationId id = world.CreateArticulation(def).value();
-  int steps = 0;
-  while (steps < 20 && world.GetJointStates(id)[0].velocity > 0.0) {
-    world.Step();
-    ++steps;
-  }
-  ASSERT_EQ(steps, 6) << "the ball should strike within the sixth step";
-  const JointState after = world.GetJointStates(id)[0];
-  const double contact_time = kStepsToImpact * kDt;
-  const double expected = contact_angle - kRestitution * omega * (steps * kDt - contact_time);
-  std::printf(
-      "%.0f m/s: end of the impact step %.12f rad, exact %.12f rad; omega+ %.12f, -e omega "
-      "%.12f\n",
-      impact_speed, after.position, expected, after.velocity, -kRestitution * omega);
-  EXPECT_NEAR(after.position, expected, 1e-9);
-  EXPECT_NEAR(after.velocity / (-kRestitution * omega), 1.0, 1e-6);
-  // Away from the box it swings back freely: theta falls at e omega.
-  world.Step();
-  EXPECT_NEAR(world.GetJointStates(id)[0].position, expected - kRestitution * omega * kDt, 1e-9);
-}
-
-TEST(ArticulationContactTest, HingedLinkStrikesAStaticBoxAtTheContactTimeAndRebounds) {
-  StrikeAStaticBox(3.0, 0.2);
-}
-
-// 30 m/s, 12.5 cm a step, against a 1 cm plate: the path's samples keep the
-// ball from passing it, and the time is as exact.
-TEST(ArticulationContactTest, FastHingedLinkStrikesAThinPlateAtTheContactTime) {
-  StrikeAStaticBox(30.0, 0.01);
-}
-
-// A rigid ball, e = 0.8, dropped h = 0.5 m onto the box of a fixed-base
-// box-with-flap bounces to e^2 h, then e^4 h: the restitution pass gives
-// it e v- and leaves its drift over the step to where it touches, so it
-// rises at most one step late (e v- dt lower) and never higher. Without
-// the pass the row that stopped it took its speed (0.012 m of 0.05 for the
-// box above); with the bounced speed drifting over the whole step it rose
-// 13 mm too high.
-TEST(ArticulationContactTest, RigidBallBouncesOnALinkToRestitutionSquared) {
-  constexpr double kDrop = 0.5;         // m, from touching
-  constexpr double kRestitution = 0.8;  // the ball's; the link's is 0
-  constexpr double kRadius = 0.05;      // m
-  World world = MakeWorld();
-  ArticulationDef def = BoxWithFlap(0.0);
-  def.fixed_base = true;
-  world.CreateArticulation(def).value();
-  SphereSpec spec;
-  spec.radius = kRadius;
-  spec.world_from_body = Translation(0.03, 0.02, 0.1 + kRadius + kDrop);
-  spec.material = MakeMaterial(0.5, kRestitution);
-  const BodyId ball = AddSphere(&world, spec);
-  double height = kDrop;
-  for (int bounce = 0; bounce < 2; ++bounce) {
-    const double impact_speed = std::sqrt(2.0 * kG * height);
-    double apex = -1.0;
-    for (int step = 0; step < 2 * 240 && apex < 0.0; ++step) {
-      const double before = world.GetLinearVelocity(ball).z();
-      world.Step();
-      if (before > 0.0 && world.GetLinearVelocity(ball).z() <= 0.0) {
-        apex = world.GetPose(ball).translation.z() - 0.1 - kRadius;
-      }
-    }
-    const double expected = kRestitution * kRestitution * height;
-    std::printf("bounce %d: apex %.5f m, e^2 h = %.5f m\n", bounce + 1, apex, expected);
-    EXPECT_LT(apex, expected + kG * kDt * kDt);
-    EXPECT_GT(apex, expected - kRestitution * impact_speed * kDt - kG * kDt * kDt);
-    height = apex;
-  }
-}
-
 // A ball spawned 1 cm into a flap that a velocity motor holds at 0 rad/s
 // (effort 100 N m), without gravity. The split impulse pushes the ball out;
 // the motor's row holds in the correction as in the velocity solve, so the
@@ -303,16 +146,6 @@ TEST(ArticulationContactTest, SplitImpulseDoesNotTurnAJointItsMotorHolds) {
   EXPECT_GT(world.GetPose(ball).translation.x(),
             0.025 + kRadius - settings.solver.penetration_slop - 1e-6);
   EXPECT_LT(world.GetLinearVelocity(ball).norm(), 1e-9);
-}
-
-LinkDef BoxLink(double mass, const Vec3& size, double friction) {
-  LinkDef link;
-  link.mass_properties = BoxMassProperties(mass / size.prod(), size);
-  ShapeDef shape;
-  shape.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(size));
-  shape.material = MakeMaterial(friction, 0.0);
-  link.shapes.push_back(shape);
-  return link;
 }
 
 // A parallel gripper on a lift: two fingers squeeze a 0.2 kg box with 20 N

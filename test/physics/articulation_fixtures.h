@@ -83,6 +83,17 @@ inline ArticulationDef BoxWithFlap(double base_z) {
   return def;
 }
 
+// A box link of `mass` and full edge lengths `size`, e = 0.
+inline LinkDef BoxLink(double mass, const Vec3& size, double friction) {
+  LinkDef link;
+  link.mass_properties = BoxMassProperties(mass / size.prod(), size);
+  ShapeDef shape;
+  shape.geometry = std::make_shared<const ConvexPolyhedron>(MakeBoxPolyhedron(size));
+  shape.material = MakeMaterial(friction, 0.0);
+  link.shapes.push_back(shape);
+  return link;
+}
+
 // A prismatic joint from `parent` to `child` at `origin`, within +-0.5 m.
 inline JointDef Slider(const std::string& name, int parent, int child, const Vec3& origin,
                        const Vec3& axis) {

@@ -111,6 +111,10 @@ class ArticulationSolver {
   int AddArticulationLike(const Eigen::VectorXd& u, const ArticulationSlot& slot);
   // The slot of a rigid body, added once.
   int BodySlotOf(const BodySlot& body);
+  // The slot of body `body` in this solve, or -1.
+  int SlotOfBody(std::uint32_t body) const {
+    return body < slot_of_body_.size() ? slot_of_body_[body] : -1;
+  }
   RowSide ArticulationSide(int slot, const Eigen::VectorXd& jacobian) const;
   // Three sides at once (a contact point's normal and tangent rows): with
   // the articulated-body passes, their responses in one fused pass.
@@ -147,6 +151,7 @@ class ArticulationSolver {
   std::vector<ConstraintRow>& rows() { return rows_; }
   std::vector<ArticulationSlot>& articulations() { return articulations_; }
   std::vector<BodySlot>& bodies() { return bodies_; }
+  const std::vector<BodySlot>& bodies() const { return bodies_; }
 
  private:
   double SideVelocity(const RowSide& side) const;

@@ -288,6 +288,7 @@ void ArticulationSystem::AddArticulationRows(std::uint32_t index, int slot,
 // its joint-space inertia M for the row solve, and only one with contacts
 // its links' Jacobians; the others take the free RK4 step.
 void ArticulationSystem::Solve(const StepContext& step) {
+  body_impacts_.clear();
   if (articulations_.empty()) return;
   solver_.Reset();
   std::vector<char>& touched = touched_scratch_;
@@ -438,6 +439,14 @@ void ArticulationSystem::TakeLinkSolveVelocities(const StepContext& step) {
     // velocity it ends the step with: dt/2 (v_start + v_end) is unchanged.
     body.start_linear_velocity -= slot_body.linear_velocity - solved.linear_velocity;
     body.start_angular_momentum -= angular_momentum - solved_momentum;
+    // One a link struck within the step drifts t_c v- + (dt - t_c) v+: the
+    // trapezoid dt/2 (v_start + v+) gives that with v_start = 2 mean - v+.
+    Vec3 mean_linear;
+    Vec3 mean_angular;
+    if (StruckBodyMeanVelocity(slot_body.body, step.dt, &mean_linear, &mean_angular)) {
+      body.start_linear_velocity = 2.0 * mean_linear - slot_body.linear_velocity;
+      body.start_angular_momentum = 2.0 * AngularMomentumFor(body, mean_angular) - angular_momentum;
+    }
     body.linear_momentum = body.mass * slot_body.linear_velocity;
     body.angular_momentum = angular_momentum;
     body.UpdateDerived();

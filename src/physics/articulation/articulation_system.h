@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -121,6 +122,12 @@ class ArticulationSystem {
                      std::vector<ShapePairContact*>* rigid_pairs);
   const std::vector<ShapePairContact*>& link_pairs() const { return link_pairs_; }
   void Solve(const StepContext& step);
+  // The mean velocities over this step of a rigid body that a link struck
+  // within it at t_c, (t_c v- + (dt - t_c) v+) / dt, with v- its velocity
+  // before the impact and v+ after (linear, and angular). False for any
+  // other body, which drifts as its solver integrates it; *linear and
+  // *angular are then left as they are.
+  bool StruckBodyMeanVelocity(std::uint32_t body, double dt, Vec3* linear, Vec3* angular) const;
   // Keeps the link pairs' impulses for the next warm start and reports
   // their points in *reports, after the rigid pairs'.
   void ReportContacts(const StepContext& step, ContactReports* reports);
@@ -153,6 +160,9 @@ class ArticulationSystem {
   std::vector<double> LinkImpactTimes(const StepContext& step,
                                       const std::vector<int>& slot_of_articulation);
   void FindApproachVelocities();
+  double SideApproachVelocity(const RowSide& side) const;
+  double SideVelocityOnPath(const RowSide& side, double fraction,
+                            const std::vector<Eigen::VectorXd>& start) const;
   double LinkPairImpactTime(const StepContext& step, const std::vector<int>& slot_of_articulation,
                             const ShapePairContact& pair, double closing_speed);
   Pose BodyPoseOnImpactPath(std::uint32_t index, const std::vector<int>& slot_of_articulation,
@@ -189,6 +199,15 @@ class ArticulationSystem {
   // Per articulation slot, its velocity before the bouncing points'
   // impulses (LinkImpactTimes).
   std::vector<Eigen::VectorXd> approach_velocities_;
+  // Per body slot of the solve, a rigid body's velocity before the bouncing
+  // points' impulses and the time a link strikes it (+infinity when none
+  // does); empty when no point bounced this step.
+  struct BodyImpact {
+    Vec3 linear_velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    double time = std::numeric_limits<double>::infinity();
+  };
+  std::vector<BodyImpact> body_impacts_;
   // BodyPoseOnImpactPath's state and kinematics at a time of the path.
   ArticulationState impact_state_;
   ArticulationKinematics impact_kinematics_;

@@ -25,24 +25,24 @@ constexpr int kMaxLinkPathSamples = 64;
 // Restitution of the link contacts that close within the step, at the
 // time they touch. A point still apart at the start of the step is stopped
 // where it touches by its row, v+ >= -s / dt. The velocity each
-// articulation had before those rows stopped it, u- = u - M^-1 J^T lambda
-// over their impulses (normal and friction), carries it along the step's
-// path in joint coordinates, q(t) = q + t u-; the time t_c its first point
-// touches on that path is found from the shapes' own gap
+// articulation and rigid body had before those rows stopped it, u- = u -
+// M^-1 J^T lambda over their impulses (normal and friction), carries it
+// along the step's path, q(t) = q + t u- in joint coordinates and
+// x(t) = x + t v-, R(t) = exp(t w-) R for a rigid body; the time t_c its
+// first point touches on that path is found from the shapes' own gap
 // (LinkPairImpactTime). The rows that took an impulse are then solved
 // again, the others' impulses held, for v+ >= -e v-, the speed it leaves
 // with (Baraff 1997, "Rigid Body Simulation II", section 8, the collision
 // impulse at the time of contact), and the articulation ends the step at
 // q + t_c u- + (dt - t_c) u+, as a rigid body does in the sub-step after
-// its impact. A point whose other side is a moving rigid body keeps the
-// end of the step as its time: the body's drift is the contact solver's
-// (the restitution pass after the position update of Box2D v3.0, Catto
-// 2024, contact_solver.c).
+// its impact; a rigid body struck by a link drifts the same way
+// (StruckBodyMeanVelocity, which both solvers' integrators read).
 void ArticulationSystem::BounceLinkContacts(const StepContext& step,
                                             const std::vector<int>& slot_of_articulation) {
   std::vector<std::size_t>& bouncing = bouncing_rows_;
   bouncing.clear();
   solved_bodies_.clear();
+  body_impacts_.clear();
   std::vector<ConstraintRow>& rows = solver_.rows();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     if (rows[k].bounce > 0.0 && rows[k].impulse > 0.0) bouncing.push_back(k);
@@ -71,17 +71,24 @@ void ArticulationSystem::BounceLinkContacts(const StepContext& step,
 }
 
 // Per articulation slot, its velocity before the bouncing points' impulses
-// (normal and friction), in approach_velocities_.
+// (normal and friction), in approach_velocities_; per rigid body slot, its
+// own, in body_impacts_.
 void ArticulationSystem::FindApproachVelocities() {
   const std::vector<ConstraintRow>& rows = solver_.rows();
   const std::vector<ArticulationSolver::ArticulationSlot>& slots = solver_.articulations();
   approach_velocities_.resize(slots.size());
   for (std::size_t slot = 0; slot < slots.size(); ++slot)
     approach_velocities_[slot] = slots[slot].u;
+  body_impacts_.clear();
+  for (const ArticulationSolver::BodySlot& body : solver_.bodies())
+    body_impacts_.push_back({body.linear_velocity, body.angular_velocity});
   const auto remove_impulse = [&](const ConstraintRow& row) {
     for (const RowSide* side : {&row.a, &row.b}) {
       if (side->kind == RowSide::Kind::kArticulation) {
         approach_velocities_[side->slot] -= row.impulse * side->response;
+      } else if (side->kind == RowSide::Kind::kBody) {
+        body_impacts_[side->slot].linear_velocity -= row.impulse * side->linear_response;
+        body_impacts_[side->slot].angular_velocity -= row.impulse * side->angular_response;
       }
     }
   };
@@ -95,10 +102,41 @@ void ArticulationSystem::FindApproachVelocities() {
   }
 }
 
+// J_k w- of one side of a row, at its approach velocities.
+double ArticulationSystem::SideApproachVelocity(const RowSide& side) const {
+  if (side.kind == RowSide::Kind::kArticulation)
+    return side.jacobian.dot(approach_velocities_[side.slot]);
+  if (side.kind != RowSide::Kind::kBody) return 0.0;
+  const BodyImpact& approach = body_impacts_[side.slot];
+  return side.linear.dot(approach.linear_velocity) + side.angular.dot(approach.angular_velocity);
+}
+
+// J_k w of one side of a row, at the velocities `fraction` of the way from
+// the step's start (before its forces; `start` per articulation slot) to
+// the approach velocities (after them, before the bouncing impulses): the
+// forces act evenly over the step.
+double ArticulationSystem::SideVelocityOnPath(const RowSide& side, double fraction,
+                                              const std::vector<Eigen::VectorXd>& start) const {
+  if (side.kind == RowSide::Kind::kArticulation) {
+    const Eigen::VectorXd& approach = approach_velocities_[side.slot];
+    return side.jacobian.dot(start[side.slot] + fraction * (approach - start[side.slot]));
+  }
+  if (side.kind != RowSide::Kind::kBody) return 0.0;
+  const BodyImpact& approach = body_impacts_[side.slot];
+  const Body& body = bodies_[solver_.bodies()[side.slot].body];
+  const Vec3 start_angular = body.inverse_inertia_world * body.start_angular_momentum;
+  const Vec3 linear = body.start_linear_velocity +
+                      fraction * (approach.linear_velocity - body.start_linear_velocity);
+  const Vec3 angular = start_angular + fraction * (approach.angular_velocity - start_angular);
+  return side.linear.dot(linear) + side.angular.dot(angular);
+}
+
 // Per articulation slot, the time its first bouncing point touches (dt
 // when none is timed), and in approach_velocities_ its velocity before the
-// bouncing points' impulses; a timed point's bounce becomes -e times the
-// speed it strikes with. Reads the rows before their bounce targets.
+// bouncing points' impulses; per rigid body slot the same in body_impacts_.
+// A timed point's bounce becomes -e times the speed it strikes with. Reads
+// the rows before their bounce targets. A row between two rigid bodies (of
+// an island a link touches) keeps the end of the step.
 std::vector<double> ArticulationSystem::LinkImpactTimes(
     const StepContext& step, const std::vector<int>& slot_of_articulation) {
   FindApproachVelocities();
@@ -121,13 +159,10 @@ std::vector<double> ArticulationSystem::LinkImpactTimes(
   std::vector<double> times(slot_count, step.dt);
   for (const std::size_t k : bouncing_rows_) {
     const ConstraintRow& row = rows[k];
-    if (row.a.kind == RowSide::Kind::kBody || row.b.kind == RowSide::Kind::kBody) continue;
-    double closing = 0.0;  // J u-, m/s
-    for (const RowSide* side : {&row.a, &row.b}) {
-      if (side->kind == RowSide::Kind::kArticulation) {
-        closing += side->jacobian.dot(approach_velocities_[side->slot]);
-      }
-    }
+    if (row.a.kind != RowSide::Kind::kArticulation && row.b.kind != RowSide::Kind::kArticulation)
+      continue;
+    // J u-, m/s
+    const double closing = SideApproachVelocity(row.a) + SideApproachVelocity(row.b);
     const double gap = -row.target * step.dt;  // s of the target -s / dt
     if (!(closing < 0.0) || !(gap >= 0.0)) continue;
     double time = std::min(gap / -closing, step.dt);
@@ -142,13 +177,14 @@ std::vector<double> ArticulationSystem::LinkImpactTimes(
     // act evenly over the step) and leaves with w, J w = -e J u_c; the
     // forces then act over the rest of the step, u+ = w + (u- - u_c). So
     // the row's target for u+ is -e J u_c + J (u- - u_c).
-    double closing_at_impact = 0.0;
+    const double closing_at_impact = SideVelocityOnPath(row.a, time / step.dt, start_velocities) +
+                                     SideVelocityOnPath(row.b, time / step.dt, start_velocities);
     for (const RowSide* side : {&row.a, &row.b}) {
-      if (side->kind != RowSide::Kind::kArticulation) continue;
-      times[side->slot] = std::min(times[side->slot], time);
-      const Eigen::VectorXd& start = start_velocities[side->slot];
-      closing_at_impact +=
-          side->jacobian.dot(start + (time / step.dt) * (approach_velocities_[side->slot] - start));
+      if (side->kind == RowSide::Kind::kArticulation) {
+        times[side->slot] = std::min(times[side->slot], time);
+      } else if (side->kind == RowSide::Kind::kBody) {
+        body_impacts_[side->slot].time = std::min(body_impacts_[side->slot].time, time);
+      }
     }
     rows[k].bounce =
         std::max(0.0, -row.restitution * closing_at_impact + (closing - closing_at_impact));
@@ -157,13 +193,25 @@ std::vector<double> ArticulationSystem::LinkImpactTimes(
 }
 
 // The pose of body `index`'s frame at time t of the step: a link's on its
-// articulation's path q + t u-, any other body's where it is (a static one,
-// or one asleep; LinkImpactTimes times no pair with a moving rigid body).
+// articulation's path q + t u-, a moving rigid body's on x + t v-,
+// exp(t w-) R, any other body's where it is (a static one, or one asleep).
 Pose ArticulationSystem::BodyPoseOnImpactPath(std::uint32_t index,
                                               const std::vector<int>& slot_of_articulation,
                                               double t) {
   const Body& body = bodies_[index];
-  if (body.articulation < 0) return body.WorldFromBody();
+  if (body.articulation < 0) {
+    const int slot = solver_.SlotOfBody(index);
+    if (slot < 0 || solver_.bodies()[slot].inverse_mass == 0.0) return body.WorldFromBody();
+    const BodyImpact& approach = body_impacts_[slot];
+    const Vec3 turn = t * approach.angular_velocity;
+    const double angle = turn.norm();
+    Pose world_from_principal{body.position + t * approach.linear_velocity, body.orientation};
+    if (angle > 0.0) {
+      world_from_principal.rotation =
+          (Quat(Eigen::AngleAxisd(angle, turn / angle)) * body.orientation).normalized();
+    }
+    return world_from_principal * body.principal_from_body;
+  }
   const ArticulationEntry& entry = articulations_[body.articulation];
   const int slot = slot_of_articulation[body.articulation];
   // The kinematics read the velocities too, which the poses do not need.
@@ -210,9 +258,14 @@ double ArticulationSystem::LinkPairImpactTime(const StepContext& step,
   // A reused manifold may call apart shapes that touch by its reuse error:
   // no bracket starts there, and the linear estimate stands.
   if (!(bracket.gap_low > 0.0)) return std::numeric_limits<double>::infinity();
+  // The thinner of the moving sides (a link, or a rigid body the link solve
+  // moves).
   double thickness = std::numeric_limits<double>::infinity();
-  for (const Body* body : {&a, &b}) {
-    if (body->articulation >= 0) thickness = std::min(thickness, body->thickness);
+  for (const std::uint32_t index : {pair.body_a, pair.body_b}) {
+    const Body& body = bodies_[index];
+    const int slot = body.articulation < 0 ? solver_.SlotOfBody(index) : -1;
+    if (body.articulation >= 0 || (slot >= 0 && solver_.bodies()[slot].inverse_mass > 0.0))
+      thickness = std::min(thickness, body.thickness);
   }
   const double step_per_sample = step.settings->continuous_fraction * thickness;
   const int samples = static_cast<int>(std::clamp(
@@ -230,6 +283,18 @@ double ArticulationSystem::LinkPairImpactTime(const StepContext& step,
   }
   if (bracket.high < 0.0) return std::numeric_limits<double>::infinity();
   return NarrowImpactBracket(gap_at, ImpactTarget{0.0, kLinkTouchingBand}, step.dt, bracket).low;
+}
+
+bool ArticulationSystem::StruckBodyMeanVelocity(std::uint32_t body, double dt, Vec3* linear,
+                                                Vec3* angular) const {
+  const int slot = body_impacts_.empty() ? -1 : solver_.SlotOfBody(body);
+  if (slot < 0 || !(body_impacts_[slot].time < dt)) return false;
+  const BodyImpact& impact = body_impacts_[slot];
+  const ArticulationSolver::BodySlot& after = solver_.bodies()[slot];
+  const double before = impact.time / dt;
+  *linear = before * impact.linear_velocity + (1.0 - before) * after.linear_velocity;
+  *angular = before * impact.angular_velocity + (1.0 - before) * after.angular_velocity;
+  return true;
 }
 
 }  // namespace rigid_body_sim::physics

@@ -201,7 +201,9 @@ void SoftStepSolver::StoreVelocities(const StepContext& step) {
 // with (and its split-impulse velocity), x += dt v, as the exact solver's
 // pushed bodies do: that solve holds a gripped box at its fingers' velocity
 // at the end of the step, and the sub-steps' drift, which lags that by
-// (n - 1) / 2n g dt^2 each step, let the box slip out of a still grip.
+// (n - 1) / 2n g dt^2 each step, let the box slip out of a still grip. One
+// that a link struck within the step drifts with its mean velocity over
+// the step, before the impact and after it (StruckBodyMeanVelocity).
 void SoftStepSolver::Integrate(const StepContext& step) {
   WorldImpl& w = world_;
   w.articulations_.Move();
@@ -219,8 +221,11 @@ void SoftStepSolver::Integrate(const StepContext& step) {
     Vec3 moved = soft.delta_position;
     Vec3 turn = Vec3::Zero();
     if (touches_link_[i]) {
-      moved = step.dt * (body.linear_velocity + body.pseudo_linear_velocity);
-      turn = step.dt * (angular_velocity + body.pseudo_angular_velocity);
+      Vec3 linear = body.linear_velocity;
+      Vec3 angular = angular_velocity;
+      w.articulations_.StruckBodyMeanVelocity(i, step.dt, &linear, &angular);
+      moved = step.dt * (linear + body.pseudo_linear_velocity);
+      turn = step.dt * (angular + body.pseudo_angular_velocity);
     } else {
       body.orientation = (soft.delta_rotation * body.orientation).normalized();
     }
