@@ -135,8 +135,9 @@ double ArticulationSystem::SideVelocityOnPath(const RowSide& side, double fracti
 // when none is timed), and in approach_velocities_ its velocity before the
 // bouncing points' impulses; per rigid body slot the same in body_impacts_.
 // A timed point's bounce becomes -e times the speed it strikes with. Reads
-// the rows before their bounce targets. A row between two rigid bodies (of
-// an island a link touches) keeps the end of the step.
+// the rows before their bounce targets. A row between two rigid bodies of
+// an island a link touches is timed as a link's: the island's pairs are not
+// the rigid solver's, so this is their time of impact.
 std::vector<double> ArticulationSystem::LinkImpactTimes(
     const StepContext& step, const std::vector<int>& slot_of_articulation) {
   FindApproachVelocities();
@@ -159,8 +160,6 @@ std::vector<double> ArticulationSystem::LinkImpactTimes(
   std::vector<double> times(slot_count, step.dt);
   for (const std::size_t k : bouncing_rows_) {
     const ConstraintRow& row = rows[k];
-    if (row.a.kind != RowSide::Kind::kArticulation && row.b.kind != RowSide::Kind::kArticulation)
-      continue;
     // J u-, m/s
     const double closing = SideApproachVelocity(row.a) + SideApproachVelocity(row.b);
     const double gap = -row.target * step.dt;  // s of the target -s / dt
