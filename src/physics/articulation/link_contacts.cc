@@ -110,7 +110,7 @@ int ArticulationSystem::AddLinkPointRows(const StepContext& step,
   const double approach = StartPointVelocity(pair.body_a, normal, point.position_world) +
                           StartPointVelocity(pair.body_b, -normal, point.position_world);
   const double separation = point.separation;
-  if (separation <= solver.contact_tolerance && approach < -solver.collision_velocity_threshold) {
+  if (ClassifyContactPoint(separation, approach, solver) == ContactType::kColliding) {
     normal_row.target = -restitution * approach;
     normal_row.colliding = true;
   } else if (separation > 0.0) {

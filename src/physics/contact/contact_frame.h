@@ -1,15 +1,32 @@
-// What every contact row shares, a body's or a link's: the tangent basis of
-// its normal, the combined material of its two shapes, and the friction
-// disc its tangential impulse is projected onto.
+// What every contact row shares, a body's or a link's: the class of its
+// point, the tangent basis of its normal, the combined material of its two
+// shapes, and the friction disc its tangential impulse is projected onto.
 #ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_FRAME_H_
 #define RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_FRAME_H_
 
 #include <array>
 #include <cmath>
 
+#include "rigid_body_sim/physics/contact.h"
 #include "rigid_body_sim/physics/types.h"
+#include "rigid_body_sim/physics/world_settings.h"
 
 namespace rigid_body_sim::physics {
+
+// A point classified by its relative normal velocity v_r = n . (pa' - pb')
+// (Baraff 1997, "Rigid Body Simulation II", section 8): touching (apart by
+// at most contact_tolerance), it is colliding when v_r < -epsilon, resting
+// when |v_r| <= epsilon and separating when v_r > epsilon, with epsilon =
+// collision_velocity_threshold. A point further apart is separating: the
+// time of impact, not this step's impulse, finds when it touches.
+inline ContactType ClassifyContactPoint(double separation, double normal_velocity,
+                                        const SolverSettings& settings) {
+  const double epsilon = settings.collision_velocity_threshold;
+  if (separation > settings.contact_tolerance) return ContactType::kSeparating;
+  if (normal_velocity < -epsilon) return ContactType::kColliding;
+  if (normal_velocity <= epsilon) return ContactType::kResting;
+  return ContactType::kSeparating;
+}
 
 // The tangent basis of a contact normal: a unit t1 orthogonal to n, and
 // t2 = n x t1. It depends on n only, so warm starts carry over.

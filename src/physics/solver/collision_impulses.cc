@@ -173,7 +173,6 @@ void ContactSolver::ComputeMasses() {
 }
 
 void ContactSolver::ResolveCollisions() {
-  const double epsilon = settings_.collision_velocity_threshold;
   std::vector<std::pair<int, int>> active;
   std::vector<double> normal;
   std::vector<std::array<double, 2>> tangent;
@@ -188,7 +187,8 @@ void ContactSolver::ResolveCollisions() {
         // Nothing has acted before the first round: Prepare's v_r holds.
         const double v_r =
             round == 0 ? point.normal_velocity_before : NormalVelocity(manifold, point);
-        if (v_r < -epsilon) active.emplace_back(m, i);
+        if (ClassifyContactPoint(point.separation, v_r, settings_) == ContactType::kColliding)
+          active.emplace_back(m, i);
       }
     }
     // A round of only inelastic points (e = 0) is the resting solve's LCP

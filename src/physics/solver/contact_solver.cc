@@ -43,17 +43,7 @@ void ContactSolver::Prepare() {
     for (int i = 0; i < manifold.point_count; ++i) {
       SolverPoint& point = manifold.points[i];
       point.normal_velocity_before = NormalVelocity(manifold, point);
-      const double epsilon = settings_.collision_velocity_threshold;
-      if (point.separation > settings_.contact_tolerance) {
-        // Apart: the time-of-impact search finds when it touches.
-        point.type = ContactType::kSeparating;
-      } else if (point.normal_velocity_before < -epsilon) {
-        point.type = ContactType::kColliding;
-      } else if (point.normal_velocity_before <= epsilon) {
-        point.type = ContactType::kResting;
-      } else {
-        point.type = ContactType::kSeparating;
-      }
+      point.type = ClassifyContactPoint(point.separation, point.normal_velocity_before, settings_);
     }
   }
 }
