@@ -26,11 +26,12 @@ namespace {
 
 // An island of rigid bodies touching a link is solved with the link's rows
 // up to this many bodies (a part a gripper presses on a table, a stack a
-// foot stands on). A larger one keeps the rigid solver for its own
-// contacts: with 16 or 64 here, an arm pushing through a lattice of 100
-// boxes (arm_push_100) took 1.4 times its step's time, and with 4, 0.94
-// (docs/performance.md, "One contact problem for an island with a link").
-constexpr std::uint32_t kMostLinkIslandBodies = 4;
+// foot stands on, a stack of 16 boxes under a pressing link). A larger one
+// keeps the rigid solver for its own contacts: with 64 here, an arm pushing
+// through a lattice of 100 boxes (arm_push_100) took 1.23 times its step's
+// time, with 16 0.98 of 4's (docs/performance.md, "Link impacts on moving
+// bodies, and a larger island with a link").
+constexpr std::uint32_t kMostLinkIslandBodies = 16;
 // rad or m: how near its limit a joint keeps its limit row.
 constexpr double kLimitTolerance = 1e-6;
 // Above this many dofs an articulation's rows take M^-1 J^T from the
