@@ -169,6 +169,7 @@ class ArticulationSystem {
                             double t);
   void CorrectLinkPenetration(const StepContext& step,
                               const std::vector<int>& slot_of_articulation);
+  void TakeUnpushedFreeSteps(const StepContext& step, const std::vector<int>& slot_of_articulation);
   void RecordJointEfforts(const StepContext& step);
   void TakeLinkSolveVelocities(const StepContext& step);
 
@@ -182,6 +183,11 @@ class ArticulationSystem {
   Eigen::VectorXd free_velocity_scratch_;        // SetUpArticulation's, u*
   std::vector<char> touched_scratch_;            // Solve's, per articulation
   std::vector<int> slot_scratch_;                // Solve's, per articulation
+  // Solve's, per articulation: in the solve for its contacts alone, and
+  // moved by its free step instead (TakeUnpushedFreeSteps).
+  std::vector<char> contact_only_;
+  std::vector<char> free_stepped_;
+  std::vector<char> pushed_scratch_;  // TakeUnpushedFreeSteps', per slot
   Eigen::VectorXd acceleration_scratch_;
   std::vector<ShapePairContact*> link_pairs_;  // TakeLinkPairs'
   UnionFind link_islands_;                     // TakeLinkPairs' scratch

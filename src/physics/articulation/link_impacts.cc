@@ -57,7 +57,7 @@ void ArticulationSystem::BounceLinkContacts(const StepContext& step,
   solver_.SweepRows(bouncing, kMaxSweeps, kSweepTolerance);
   for (std::uint32_t i = 0; i < articulations_.size(); ++i) {
     const int slot = slot_of_articulation[i];
-    if (slot < 0) continue;
+    if (slot < 0 || free_stepped_[i] != 0) continue;
     ArticulationEntry& entry = articulations_[i];
     const Eigen::VectorXd& u_after = solver_.articulations()[slot].u;
     const double t_c = impact_times[slot];
