@@ -160,6 +160,11 @@ class ArticulationSystem {
   std::vector<double> LinkImpactTimes(const StepContext& step,
                                       const std::vector<int>& slot_of_articulation);
   void FindApproachVelocities();
+  void CapBounceEnergy(const std::vector<int>& slot_of_articulation);
+  // Kinetic energies at the step's start pose.
+  double LinkKineticEnergy(const ArticulationEntry& entry, const Eigen::VectorXd& u);
+  static double BodyKineticEnergy(const Body& body, const Vec3& linear_velocity,
+                                  const Vec3& angular_velocity);
   double SideApproachVelocity(const RowSide& side) const;
   double SideVelocityOnPath(const RowSide& side, double fraction,
                             const std::vector<Eigen::VectorXd>& start) const;
@@ -220,6 +225,11 @@ class ArticulationSystem {
   // The rigid bodies' velocities of the link solve before its restitution
   // pass, per body slot; empty when no point bounced this step.
   std::vector<ArticulationSolver::BodySlot> solved_bodies_;
+  // The same for the articulations' velocities per slot, and the bouncing
+  // rows' impulses (CapBounceEnergy's).
+  std::vector<Eigen::VectorXd> solved_articulations_;
+  std::vector<double> solved_impulses_;
+  std::vector<int> articulation_of_slot_;  // CapBounceEnergy's scratch
   ArticulationSolver pseudo_solver_;
 };
 

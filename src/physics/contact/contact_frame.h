@@ -1,9 +1,11 @@
 // What every contact row shares, a body's or a link's: the class of its
 // point, the tangent basis of its normal, the combined material of its two
-// shapes, and the friction disc its tangential impulse is projected onto.
+// shapes, the friction disc its tangential impulse is projected onto, and
+// the share of restitution that adds no energy.
 #ifndef RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_FRAME_H_
 #define RIGID_BODY_SIM_PHYSICS_CONTACT_CONTACT_FRAME_H_
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -35,6 +37,20 @@ std::array<Vec3, 2> TangentBasis(const Vec3& normal);
 // Combination rules: e = max(ea, eb), mu = sqrt(mu_a mu_b).
 double CombineRestitution(double restitution_a, double restitution_b);
 double CombineFriction(double friction_a, double friction_b);
+
+// The largest s in [0, 1] with gain(s) = b s + q s^2 <= room: how much of
+// its restitution impulses a collision may apply without adding energy.
+inline double RestitutionScale(double b, double q, double room) {
+  if (room <= 0.0) return 0.0;
+  if (b + q <= room) return 1.0;
+  double scale = 0.0;
+  if (q > 0.0) {
+    scale = (-b + std::sqrt(b * b + 4.0 * q * room)) / (2.0 * q);
+  } else if (b > 0.0) {
+    scale = room / b;
+  }
+  return std::clamp(scale, 0.0, 1.0);
+}
 
 // Projects the tangential impulse onto the disc |t| <= limit (a circular
 // friction cone, so there is no directional bias).

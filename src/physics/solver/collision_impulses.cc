@@ -63,20 +63,6 @@ double KineticEnergy(const std::vector<SolverBody>& bodies,
   return energy;
 }
 
-// The largest s in [0, 1] with gain(s) = b s + q s^2 <= room: how much of
-// its restitution impulses a round may apply without adding energy.
-double RestitutionScale(double b, double q, double room) {
-  if (room <= 0.0) return 0.0;
-  if (b + q <= room) return 1.0;
-  double scale = 0.0;
-  if (q > 0.0) {
-    scale = (-b + std::sqrt(b * b + 4.0 * q * room)) / (2.0 * q);
-  } else if (b > 0.0) {
-    scale = room / b;
-  }
-  return std::clamp(scale, 0.0, 1.0);
-}
-
 }  // namespace
 
 double ContactSolver::CollisionSweep(const std::vector<std::pair<int, int>>& active,
