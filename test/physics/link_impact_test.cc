@@ -136,6 +136,56 @@ TEST(ArticulationContactTest, FastHingedLinkStrikesAThinPlateAtTheContactTime) {
   StrikeAStaticBox(30.0, 0.01);
 }
 
+// The strikes below: no gravity, no friction, e = kStrikeRestitution, and
+// the first touch kStepsToImpact steps in at kStrikeSpeed.
+constexpr double kStrikeSpeed = 3.0;  // m/s
+constexpr double kStrikeRestitution = 0.5;
+constexpr double kStepsToImpact = 5.37;
+
+World WorldWithoutGravity(MotionSolverKind solver) {
+  WorldSettings settings;
+  settings.motion_solver = solver;
+  settings.time_step = kDt;
+  settings.gravity = Vec3::Zero();
+  return World(settings);
+}
+
+// A cube link of `size` and `mass` on a slider along `axis` from a fixed
+// base at the origin, at `position` moving at `velocity`.
+struct SlidingCube {
+  double mass = 1.0;  // kg
+  double size = 0.1;  // m
+  Vec3 axis = Vec3::UnitX();
+  double position = 0.0;  // m
+  double velocity = 0.0;  // m/s
+};
+
+ArticulationId AddSlidingCube(World* world, const SlidingCube& spec) {
+  ArticulationDef def;
+  def.fixed_base = true;
+  LinkDef link = BoxLink(spec.mass, Vec3::Constant(spec.size), 0.0);
+  link.shapes[0].material = MakeMaterial(0.0, kStrikeRestitution);
+  def.links = {Anchor(), link};
+  JointDef slider = Slider("slide", 0, 1, Vec3::Zero(), spec.axis);
+  slider.lower = -1.0;
+  slider.upper = 1.0;
+  slider.position = spec.position;
+  slider.velocity = spec.velocity;
+  def.joints = {slider};
+  return world->CreateArticulation(def).value();
+}
+
+// Steps until `body`, at rest, moves along x (at most 20 steps); returns
+// the steps taken.
+int StepUntilStruck(World* world, BodyId body) {
+  int steps = 0;
+  while (steps < 20 && world->GetLinearVelocity(body).x() == 0.0) {
+    world->Step();
+    ++steps;
+  }
+  return steps;
+}
+
 // A 1 kg box on a slider, at 3 m/s without gravity, strikes a free 3 kg box
 // at rest face to face, e = 0.5, no friction, t_c = 5.37 steps in: the
 // impact of two masses on a line, v1+ = (m1 - e m2) / (m1 + m2) v and
@@ -145,42 +195,27 @@ TEST(ArticulationContactTest, FastHingedLinkStrikesAThinPlateAtTheContactTime) {
 // only a static body's impact was timed, the link ended the step 3.0 mm
 // off and the box 1.0 mm (1.7 mm under the soft step). Both solvers.
 void StrikeAFreeBox(MotionSolverKind solver) {
-  constexpr double kSpeed = 3.0;        // m/s
+  constexpr double kSpeed = kStrikeSpeed;
+  constexpr double kRestitution = kStrikeRestitution;
   constexpr double kLinkMass = 1.0;     // kg
   constexpr double kBoxMass = 3.0;      // kg
-  constexpr double kRestitution = 0.5;  // both materials
-  constexpr double kStepsToImpact = 5.37;
   constexpr double kSize = 0.1;         // m, both cubes
   constexpr double kContactLink = 0.1;  // m, the slider's position at the touch
   constexpr double kBoxStart = kContactLink + kSize;
-  WorldSettings settings;
-  settings.motion_solver = solver;
-  settings.time_step = kDt;
-  settings.gravity = Vec3::Zero();
-  World world(settings);
+  World world = WorldWithoutGravity(solver);
   BoxSpec box;
-  box.size = Vec3(kSize, kSize, kSize);
+  box.size = Vec3::Constant(kSize);
   box.mass = kBoxMass;
   box.world_from_body = Translation(kBoxStart, 0.0, 0.0);
   box.material = MakeMaterial(0.0, kRestitution);
   const BodyId free_box = AddBox(&world, box);
-  ArticulationDef def;
-  def.fixed_base = true;
-  LinkDef link = BoxLink(kLinkMass, Vec3(kSize, kSize, kSize), 0.0);
-  link.shapes[0].material = MakeMaterial(0.0, kRestitution);
-  def.links = {Anchor(), link};
-  JointDef slider = Slider("slide", 0, 1, Vec3::Zero(), Vec3::UnitX());
-  slider.lower = -1.0;
-  slider.upper = 1.0;
-  slider.position = kContactLink - kSpeed * kStepsToImpact * kDt;
-  slider.velocity = kSpeed;
-  def.joints = {slider};
-  const ArticulationId id = world.CreateArticulation(def).value();
-  int steps = 0;
-  while (steps < 20 && world.GetLinearVelocity(free_box).x() == 0.0) {
-    world.Step();
-    ++steps;
-  }
+  SlidingCube link;
+  link.mass = kLinkMass;
+  link.size = kSize;
+  link.position = kContactLink - kSpeed * kStepsToImpact * kDt;
+  link.velocity = kSpeed;
+  const ArticulationId id = AddSlidingCube(&world, link);
+  const int steps = StepUntilStruck(&world, free_box);
   ASSERT_EQ(steps, 6) << "the link should strike within the sixth step";
   const double link_after = (kLinkMass - kRestitution * kBoxMass) / (kLinkMass + kBoxMass) * kSpeed;
   const double box_after = (1.0 + kRestitution) * kLinkMass / (kLinkMass + kBoxMass) * kSpeed;
@@ -222,19 +257,14 @@ TEST(ArticulationContactTest, LinkStrikesAFreeBoxAtTheContactTimeUnderTheSoftSte
 // only rows with a link were timed, A left at 2.50 m/s and ended the step
 // 1.4 mm short (4.6 mm past under the soft step).
 void StrikeABoxTouchingALink(MotionSolverKind solver) {
-  constexpr double kSpeed = 3.0;        // m/s
-  constexpr double kMassA = 1.0;        // kg
-  constexpr double kMassB = 2.0;        // kg
-  constexpr double kRestitution = 0.5;  // all materials
-  constexpr double kStepsToImpact = 5.37;
-  constexpr double kSize = 0.1;  // m, A and the link
-  WorldSettings settings;
-  settings.motion_solver = solver;
-  settings.time_step = kDt;
-  settings.gravity = Vec3::Zero();
-  World world(settings);
+  constexpr double kSpeed = kStrikeSpeed;
+  constexpr double kRestitution = kStrikeRestitution;
+  constexpr double kMassA = 1.0;  // kg
+  constexpr double kMassB = 2.0;  // kg
+  constexpr double kSize = 0.1;   // m, A and the link
+  World world = WorldWithoutGravity(solver);
   BoxSpec box;
-  box.size = Vec3(kSize, kSize, kSize);
+  box.size = Vec3::Constant(kSize);
   box.material = MakeMaterial(0.0, kRestitution);
   box.mass = kMassA;
   box.world_from_body = Translation(0.0, 0.0, 0.0);
@@ -242,28 +272,18 @@ void StrikeABoxTouchingALink(MotionSolverKind solver) {
   // B is smaller, on A's axis (no torque), 1 cm clear of the link's face.
   constexpr double kSizeB = 0.08;
   const double b_contact = -0.5 * (kSize + kSizeB);  // B's centre when it touches A
-  box.size = Vec3(kSizeB, kSizeB, kSizeB);
+  box.size = Vec3::Constant(kSizeB);
   box.mass = kMassB;
   box.world_from_body = Translation(b_contact - kSpeed * kStepsToImpact * kDt, 0.0, 0.0);
   box.linear_velocity = Vec3(kSpeed, 0.0, 0.0);
   const BodyId b = AddBox(&world, box);
   // The link's face on A's +y face, touching, both at rest.
-  ArticulationDef def;
-  def.fixed_base = true;
-  LinkDef link = BoxLink(1.0, Vec3(kSize, kSize, kSize), 0.0);
-  link.shapes[0].material = MakeMaterial(0.0, kRestitution);
-  def.links = {Anchor(), link};
-  JointDef slider = Slider("slide", 0, 1, Vec3::Zero(), Vec3::UnitY());
-  slider.lower = -1.0;
-  slider.upper = 1.0;
-  slider.position = kSize;
-  def.joints = {slider};
-  const ArticulationId id = world.CreateArticulation(def).value();
-  int steps = 0;
-  while (steps < 20 && world.GetLinearVelocity(a).x() == 0.0) {
-    world.Step();
-    ++steps;
-  }
+  SlidingCube link;
+  link.size = kSize;
+  link.axis = Vec3::UnitY();
+  link.position = kSize;
+  const ArticulationId id = AddSlidingCube(&world, link);
+  const int steps = StepUntilStruck(&world, a);
   ASSERT_EQ(steps, 6) << "B should strike A within the sixth step";
   const double a_after = (1.0 + kRestitution) * kMassB / (kMassA + kMassB) * kSpeed;
   const double b_after = (kMassB - kRestitution * kMassA) / (kMassA + kMassB) * kSpeed;
