@@ -44,11 +44,21 @@ constexpr double kSafety = 0.5;
 // parts failed, this many steps pass before they are tried again.
 constexpr int kStepsBeforeRetry = 64;
 
-struct Energy {
-  double kinetic = 0.0;    // J
-  double potential = 0.0;  // J, of gravity, zero at the world's origin
-  double magnitude = 0.0;  // J, the sum of the terms' magnitudes
-};
+bool WrenchesOnLinks(const ArticulationModel& model) {
+  for (const ArticulationLink& link : model.links) {
+    if (!link.force.isZero(0.0) || !link.torque.isZero(0.0)) return true;
+  }
+  return false;
+}
+
+// The velocities of a state whose u is scaled by s: every one is linear in u.
+void ScaleVelocities(double s, ArticulationKinematics* k) {
+  for (Vec3& v : k->linear_velocity) v *= s;
+  for (Vec3& w : k->angular_velocity) w *= s;
+  for (double& v : k->joint_velocity) v *= s;
+}
+
+}  // namespace
 
 // E = sum_i (m_i v_i^2 / 2 + omega_i . I_i omega_i / 2 - m_i g . c_i) over
 // the links that move: a fixed base's constant term would only change the
@@ -68,22 +78,6 @@ Energy EnergyOf(const ArticulationModel& model, const ArticulationKinematics& k,
   }
   return energy;
 }
-
-bool WrenchesOnLinks(const ArticulationModel& model) {
-  for (const ArticulationLink& link : model.links) {
-    if (!link.force.isZero(0.0) || !link.torque.isZero(0.0)) return true;
-  }
-  return false;
-}
-
-// The velocities of a state whose u is scaled by s: every one is linear in u.
-void ScaleVelocities(double s, ArticulationKinematics* k) {
-  for (Vec3& v : k->linear_velocity) v *= s;
-  for (Vec3& w : k->angular_velocity) w *= s;
-  for (double& v : k->joint_velocity) v *= s;
-}
-
-}  // namespace
 
 int FreeMotionIntegrator::MostParts(const ArticulationModel& model) {
   const std::size_t moving = model.links.size() - (model.fixed_base ? 1 : 0);

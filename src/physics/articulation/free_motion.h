@@ -12,6 +12,18 @@
 
 namespace rigid_body_sim::physics {
 
+// An articulation's energy at a state's kinematics.
+struct Energy {
+  double kinetic = 0.0;    // J
+  double potential = 0.0;  // J, of gravity, zero at the world's origin
+  double magnitude = 0.0;  // J, the sum of the terms' magnitudes
+};
+
+// E = sum_i (m_i v_i^2 / 2 + omega_i . I_i omega_i / 2 - m_i g . c_i) over
+// the links that move (articulation_free_motion.cc).
+Energy EnergyOf(const ArticulationModel& model, const ArticulationKinematics& k,
+                const Vec3& gravity);
+
 // One free step's inputs.
 struct FreeMotionStep {
   const ArticulationModel& model;

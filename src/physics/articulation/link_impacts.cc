@@ -152,21 +152,14 @@ void ArticulationSystem::CapBounceEnergy(const std::vector<int>& slot_of_articul
 }
 
 // T = sum_i (m_i v_i^2 + w_i . I_i w_i) / 2 over the links that move, at
-// joint velocities u and the step's start pose.
+// joint velocities u and the step's start pose (the free step's EnergyOf).
 double ArticulationSystem::LinkKineticEnergy(const ArticulationEntry& entry,
                                              const Eigen::VectorXd& u) {
   impact_state_ = entry.state;
   impact_state_.u = u;
   ComputeKinematics(entry.model, impact_state_, &impact_kinematics_,
                     KinematicsParts::kPosesAndVelocities);
-  double sum = 0.0;
-  for (std::size_t i = entry.model.fixed_base ? 1 : 0; i < entry.model.links.size(); ++i) {
-    const Vec3& v = impact_kinematics_.linear_velocity[i];
-    const Vec3& w = impact_kinematics_.angular_velocity[i];
-    sum += 0.5 * entry.model.links[i].mass * v.squaredNorm() +
-           0.5 * w.dot(impact_kinematics_.inertia_world[i] * w);
-  }
-  return sum;
+  return EnergyOf(entry.model, impact_kinematics_, Vec3::Zero()).kinetic;
 }
 
 double ArticulationSystem::BodyKineticEnergy(const Body& body, const Vec3& linear_velocity,
@@ -307,13 +300,8 @@ Pose ArticulationSystem::BodyPoseOnImpactPath(std::uint32_t index,
     const int slot = solver_.SlotOfBody(index);
     if (slot < 0 || solver_.bodies()[slot].inverse_mass == 0.0) return body.WorldFromBody();
     const BodyImpact& approach = body_impacts_[slot];
-    const Vec3 turn = t * approach.angular_velocity;
-    const double angle = turn.norm();
-    Pose world_from_principal{body.position + t * approach.linear_velocity, body.orientation};
-    if (angle > 0.0) {
-      world_from_principal.rotation =
-          (Quat(Eigen::AngleAxisd(angle, turn / angle)) * body.orientation).normalized();
-    }
+    const Pose world_from_principal{body.position + t * approach.linear_velocity,
+                                    Rotated(body.orientation, t * approach.angular_velocity)};
     return world_from_principal * body.principal_from_body;
   }
   const ArticulationEntry& entry = articulations_[body.articulation];

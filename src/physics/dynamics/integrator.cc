@@ -37,6 +37,8 @@ Eigen::Vector4d QuaternionRate(const Eigen::Vector4d& wxyz, const Vec3& inverse_
   return 0.5 * Eigen::Vector4d(rate.w(), rate.x(), rate.y(), rate.z());
 }
 
+}  // namespace
+
 // q turned by the rotation vector theta (|theta| about theta / |theta|),
 // exactly: exp(theta / 2) q.
 Quat Rotated(const Quat& q, const Vec3& rotation_vector) {
@@ -44,8 +46,6 @@ Quat Rotated(const Quat& q, const Vec3& rotation_vector) {
   if (angle == 0.0) return q;
   return (Quat(Eigen::AngleAxisd(angle, rotation_vector / angle)) * q).normalized();
 }
-
-}  // namespace
 
 Quat DriftOrientation(const Quat& world_from_principal, const Vec3& inverse_principal_moments,
                       const Vec3& start_angular_momentum, const Vec3& end_angular_momentum,

@@ -47,6 +47,10 @@ struct BodyPath {
 // the rotation vector the angular velocity alone would give.
 Vec3 TurnBetween(const Quat& from, const Quat& to, const Vec3& guess);
 
+// q turned by the rotation vector theta (|theta| about theta / |theta|),
+// exactly: exp(theta / 2) q, normalized; q itself when theta is zero.
+Quat Rotated(const Quat& q, const Vec3& rotation_vector);
+
 // L = I_world w, with I_world = R diag(I) R^T at the body's orientation:
 // the angular momentum that turns it at `angular_velocity`.
 Vec3 AngularMomentumFor(const Body& body, const Vec3& angular_velocity);
